@@ -1,0 +1,31 @@
+# Every dependency comes from a Debian 12 package (scripts/setup-debian.sh installs them).
+find_package(Threads REQUIRED)
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+find_package(cppzmq REQUIRED)
+find_package(Protobuf REQUIRED)
+find_package(HDF5 REQUIRED COMPONENTS C CXX)
+find_package(MPI REQUIRED COMPONENTS CXX)
+find_package(OpenMP REQUIRED COMPONENTS CXX)
+find_package(fmt REQUIRED)
+find_package(spdlog REQUIRED)
+find_package(CLI11 QUIET CONFIG)
+if(NOT CLI11_FOUND)
+  # Debian's libcli11-dev ships the header only; wrap it in the usual target name.
+  find_path(CLI11_INCLUDE_DIR CLI/CLI.hpp REQUIRED)
+  add_library(CLI11::CLI11 INTERFACE IMPORTED)
+  target_include_directories(CLI11::CLI11 INTERFACE ${CLI11_INCLUDE_DIR})
+endif()
+find_package(nanoflann REQUIRED)
+find_package(xsimd QUIET)
+# Plots and scene tools need Debian's interpreter (it has numpy, matplotlib and h5py).
+set(Python3_EXECUTABLE /usr/bin/python3 CACHE FILEPATH "Python with numpy, matplotlib, h5py")
+find_package(Python3 COMPONENTS Interpreter)
+
+# One imported target for HDF5 (the FindHDF5 module gives variables, not targets, on 3.25).
+if(NOT TARGET valvefsi::hdf5)
+  add_library(valvefsi_hdf5 INTERFACE)
+  add_library(valvefsi::hdf5 ALIAS valvefsi_hdf5)
+  target_include_directories(valvefsi_hdf5 SYSTEM INTERFACE ${HDF5_INCLUDE_DIRS})
+  target_link_libraries(valvefsi_hdf5 INTERFACE ${HDF5_LIBRARIES} ${HDF5_CXX_LIBRARIES})
+  target_compile_definitions(valvefsi_hdf5 INTERFACE ${HDF5_DEFINITIONS})
+endif()

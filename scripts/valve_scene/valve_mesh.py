@@ -1,0 +1,247 @@
+"""Structured leaflet meshes of the parametric valve: a quad grid per leaflet (columns along
+the circumferential parameter s, rows from the attachment to the free edge, uniform in arc
+length), written as triangles (each quad split) and hexahedra (quads extruded +-t/2 along
+the node normals), with node sets, element sets, material axes and, for the 1/6 sector,
+its symmetry and contact planes.
+
+The sector is cut out of the full valve's leaflet 0 (columns s >= 0) after the node normals
+were computed on the whole leaflet, so it is exactly the corresponding part of the full mesh.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .valve_geometry import (LEAFLET_COUNT, SECTOR_HALF_ANGLE, ValveParameters, leaflet_point,
+                             leaflet_rotation)
+
+# Quad cells per leaflet (circumferential over the whole leaflet, radial). The medium full
+# valve has 3 * 48 * 28 * 2 = 8064 triangles (the reference used 7896 bricks).
+RESOLUTIONS = {"coarse": (24, 14), "medium": (48, 28), "fine": (96, 56)}
+VARIANTS = ("full", "sector")
+ELEMENT_FAMILIES = ("both", "triangles", "hexahedra")
+
+
+@dataclass
+class ValveMesh:
+    nodes: np.ndarray                                   # [N, 3] (m)
+    triangles: np.ndarray | None = None                 # [T, 3]
+    triangle_thickness: np.ndarray | None = None        # [T]
+    triangle_circumferential: np.ndarray | None = None  # [T, 3]
+    triangle_radial: np.ndarray | None = None           # [T, 3]
+    hexahedra: np.ndarray | None = None                 # [H, 8]
+    hexahedron_circumferential: np.ndarray | None = None
+    hexahedron_radial: np.ndarray | None = None
+    node_sets: dict = field(default_factory=dict)       # name -> int64 [k]
+    element_sets: dict = field(default_factory=dict)    # name -> (element_type, int64 [k])
+    symmetry_planes: dict = field(default_factory=dict)  # name -> (point, normal)
+    contact_planes: dict = field(default_factory=dict)   # name -> (point, normal toward the leaflet)
+    description: dict = field(default_factory=dict)     # provenance attributes
+
+
+def leaflet_grid(p: ValveParameters, cells_circumferential: int, cells_radial: int) -> np.ndarray:
+    """Nodes of leaflet 0, shape [nu + 1, nv + 1, 3]; rows uniform in arc length per column."""
+    nu, nv = cells_circumferential, cells_radial
+    s = np.linspace(-1.0, 1.0, nu + 1)
+    v_dense = np.linspace(0.0, 1.0, 801)
+    grid = np.empty((nu + 1, nv + 1, 3))
+    for i, s_i in enumerate(s):
+        dense = leaflet_point(p, s_i, v_dense)
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(dense, axis=0), axis=1))])
+        v = np.interp(np.linspace(0.0, arc[-1], nv + 1), arc, v_dense)
+        grid[i] = leaflet_point(p, s_i, v)
+    return grid
+
+
+def quad_split(i: int, nu: int):
+    """Local corner pairs of the two triangles of quad column i, mirror-symmetric about the
+    bisector: the left half splits along (i,j)-(i+1,j+1), the right half along (i+1,j)-(i,j+1).
+    Corners are (di, dj) offsets, counter-clockwise in (s, v), i.e. seen from the outflow side."""
+    if i < nu // 2:
+        return (((0, 0), (1, 0), (1, 1)), ((0, 0), (1, 1), (0, 1)))
+    return (((0, 0), (1, 0), (0, 1)), ((1, 0), (1, 1), (0, 1)))
+
+
+def _triangle_normals(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
+    """Area-weighted (unnormalised, length = 2 * area) normals."""
+    a, b, c = points[tris[:, 0]], points[tris[:, 1]], points[tris[:, 2]]
+    return np.cross(b - a, c - a)
+
+
+def _local_triangles(nu: int, nv: int, columns: range):
+    """Triangles of leaflet-local grid indices (flattened over the kept columns)."""
+    first = columns.start
+    width = nv + 1
+    tris, quad_of_tri = [], []
+    for i in columns[:-1]:
+        for j in range(nv):
+            for corners in quad_split(i, nu):
+                tris.append([(i + di - first) * width + (j + dj) for di, dj in corners])
+                quad_of_tri.append((i - first) * nv + j)
+    return np.array(tris, dtype=np.int64), np.array(quad_of_tri, dtype=np.int64)
+
+
+def _local_quads(nv: int, columns: range) -> np.ndarray:
+    first, width = columns.start, nv + 1
+    quads = []
+    for i in columns[:-1]:
+        for j in range(nv):
+            c = (i - first) * width + j
+            quads.append([c, c + width, c + width + 1, c + 1])  # (i,j) (i+1,j) (i+1,j+1) (i,j+1)
+    return np.array(quads, dtype=np.int64)
+
+
+def _node_normals(grid: np.ndarray, nu: int, nv: int) -> np.ndarray:
+    """Unit normals at the grid nodes of the whole leaflet (area-weighted triangle normals)."""
+    points = grid.reshape(-1, 3)
+    tris, _ = _local_triangles(nu, nv, range(0, nu + 1))
+    normals = _triangle_normals(points, tris)
+    accumulated = np.zeros_like(points)
+    for corner in range(3):
+        np.add.at(accumulated, tris[:, corner], normals)
+    return (accumulated / np.linalg.norm(accumulated, axis=1)[:, None]).reshape(grid.shape)
+
+
+def _in_plane_axes(circumferential_hint: np.ndarray, normal: np.ndarray):
+    """Circumferential: the hint projected on the element plane; radial = normal x circumferential."""
+    n = normal / np.linalg.norm(normal, axis=1)[:, None]
+    c = circumferential_hint - np.sum(circumferential_hint * n, axis=1)[:, None] * n
+    c /= np.linalg.norm(c, axis=1)[:, None]
+    r = np.cross(n, c)
+    return c, r / np.linalg.norm(r, axis=1)[:, None]
+
+
+def build_valve_mesh(variant: str = "full", resolution: str = "medium", elements: str = "both",
+                     params: ValveParameters | None = None,
+                     cells: tuple[int, int] | None = None) -> ValveMesh:
+    """The valve mesh. `cells` = (circumferential per leaflet, even; radial) overrides `resolution`."""
+    p = params or ValveParameters()
+    p.validate()
+    if variant not in VARIANTS:
+        raise ValueError(f"variant '{variant}': allowed {', '.join(VARIANTS)}")
+    if elements not in ELEMENT_FAMILIES:
+        raise ValueError(f"elements '{elements}': allowed {', '.join(ELEMENT_FAMILIES)}")
+    if cells is None:
+        if resolution not in RESOLUTIONS:
+            raise ValueError(f"resolution '{resolution}': allowed {', '.join(RESOLUTIONS)}")
+        cells = RESOLUTIONS[resolution]
+    nu, nv = cells
+    if nu < 2 or nu % 2 or nv < 1:
+        raise ValueError(f"cells {cells}: circumferential count must be even and >= 2, radial >= 1")
+
+    grid0 = leaflet_grid(p, nu, nv)
+    normals0 = _node_normals(grid0, nu, nv)
+    columns = range(0, nu + 1) if variant == "full" else range(nu // 2, nu + 1)
+    leaflets = range(LEAFLET_COUNT) if variant == "full" else range(1)
+    kept_grid = grid0[columns.start:].reshape(-1, 3)
+    kept_normals = normals0[columns.start:].reshape(-1, 3)
+    width = nv + 1
+    per_leaflet = len(columns) * width
+    mid_count = per_leaflet * len(leaflets)
+
+    local_i = np.repeat(np.arange(columns.start, nu + 1), width)
+    local_j = np.tile(np.arange(width), len(columns))
+    is_attachment = (local_j == 0) | (local_i == 0) | (local_i == nu)
+    is_free_edge = local_j == nv
+    midpoint_local = int(np.flatnonzero((local_i == nu // 2) & is_free_edge)[0])
+
+    mid = np.concatenate([kept_grid @ leaflet_rotation(k).T for k in leaflets])
+    nrm = np.concatenate([kept_normals @ leaflet_rotation(k).T for k in leaflets])
+    with_triangles = elements in ("both", "triangles")
+    with_hexahedra = elements in ("both", "hexahedra")
+    layers = {}  # node layer -> offset of its first node
+    blocks = []
+    if with_triangles:
+        layers["mid"] = 0
+        blocks.append(mid)
+    if with_hexahedra:
+        half = 0.5 * p.thickness
+        layers["ventricular"] = sum(len(b) for b in blocks)
+        blocks.append(mid - half * nrm)
+        layers["aortic"] = sum(len(b) for b in blocks)
+        blocks.append(mid + half * nrm)
+    mesh = ValveMesh(nodes=np.concatenate(blocks))
+
+    tri_local, tri_quad = _local_triangles(nu, nv, columns)
+    quad_local = _local_quads(nv, columns)
+    quad_count = len(quad_local)
+    tris, tri_c, tri_r, hexes, hex_c, hex_r = [], [], [], [], [], []
+    for n_k, k in enumerate(leaflets):
+        base = n_k * per_leaflet
+        points = mid[base:base + per_leaflet]
+        # circumferential hint per quad: mean of its two s-direction edges
+        q = quad_local
+        hint = 0.5 * (points[q[:, 1]] - points[q[:, 0]] + points[q[:, 2]] - points[q[:, 3]])
+        if with_triangles:
+            tri_normal = _triangle_normals(points, tri_local)
+            c, r = _in_plane_axes(hint[tri_quad], tri_normal)
+            tris.append(tri_local + base + layers["mid"])
+            tri_c.append(c)
+            tri_r.append(r)
+        if with_hexahedra:
+            radial_hint = 0.5 * (points[q[:, 3]] - points[q[:, 0]] + points[q[:, 2]] - points[q[:, 1]])
+            c, r = _in_plane_axes(hint, np.cross(hint, radial_hint))
+            hexes.append(np.concatenate([quad_local + base + layers["ventricular"],
+                                         quad_local + base + layers["aortic"]], axis=1))
+            hex_c.append(c)
+            hex_r.append(r)
+
+    if with_triangles:
+        mesh.triangles = np.concatenate(tris)
+        mesh.triangle_thickness = np.full(len(mesh.triangles), p.thickness)
+        mesh.triangle_circumferential = np.concatenate(tri_c)
+        mesh.triangle_radial = np.concatenate(tri_r)
+        per = len(tri_local)
+        for n_k, k in enumerate(leaflets):
+            mesh.element_sets[f"leaflet_{k}_triangles"] = ("triangle", np.arange(n_k * per, (n_k + 1) * per, dtype=np.int64))
+    if with_hexahedra:
+        mesh.hexahedra = np.concatenate(hexes)
+        mesh.hexahedron_circumferential = np.concatenate(hex_c)
+        mesh.hexahedron_radial = np.concatenate(hex_r)
+        for n_k, k in enumerate(leaflets):
+            mesh.element_sets[f"leaflet_{k}_hexahedra"] = ("hexahedron", np.arange(n_k * quad_count, (n_k + 1) * quad_count, dtype=np.int64))
+
+    def in_layers(local_mask: np.ndarray, layer_names) -> np.ndarray:
+        ids = [layers[name] + n_k * per_leaflet + np.flatnonzero(local_mask)
+               for name in layer_names for n_k in range(len(leaflets))]
+        return np.sort(np.concatenate(ids)).astype(np.int64)
+
+    all_layers = list(layers)
+    everywhere = np.ones(per_leaflet, dtype=bool)
+    mesh.node_sets["attachment"] = in_layers(is_attachment, all_layers)
+    mesh.node_sets["free_edge"] = in_layers(is_free_edge, all_layers)
+    marker_layer = "mid" if with_triangles else "aortic"
+    mesh.node_sets["free_edge_midpoints"] = np.array(
+        [layers[marker_layer] + n_k * per_leaflet + midpoint_local for n_k in range(len(leaflets))], dtype=np.int64)
+    if with_triangles:
+        mesh.node_sets["triangle_nodes"] = in_layers(everywhere, ["mid"])
+    if with_hexahedra:
+        mesh.node_sets["hexahedron_nodes"] = in_layers(everywhere, ["ventricular", "aortic"])
+    for n_k, k in enumerate(leaflets):
+        mesh.node_sets[f"leaflet_{k}"] = np.sort(np.concatenate(
+            [layers[name] + n_k * per_leaflet + np.arange(per_leaflet) for name in all_layers])).astype(np.int64)
+
+    if variant == "sector":
+        # Leaflet 0 between its bisecting plane (y = 0: the leaflet continues across it as
+        # its own mirror image -> symmetry plane) and the coaptation plane at +60 deg (the
+        # neighbour is this half's mirror image there, but the leaflet is not continuous
+        # across it -> rigid contact plane, not a constraint).
+        on_bisector = local_i == nu // 2
+        mesh.symmetry_planes["leaflet_bisector"] = (np.zeros(3), np.array([0.0, 1.0, 0.0]))
+        mesh.node_sets["symmetry_leaflet_bisector"] = in_layers(on_bisector, all_layers)
+        normal = np.array([math.sin(SECTOR_HALF_ANGLE), -math.cos(SECTOR_HALF_ANGLE), 0.0])
+        mesh.contact_planes["coaptation"] = (np.zeros(3), normal)
+
+    mesh.description = {
+        "generator": "valve_scene.generate",
+        "variant": variant,
+        "resolution": resolution if cells == RESOLUTIONS.get(resolution) else f"{nu}x{nv}",
+        "cells_circumferential_per_leaflet": nu,
+        "cells_radial": nv,
+        "leaflet_count_in_file": len(leaflets),
+        "full_valve_fraction": 1.0 if variant == "full" else 1.0 / (2 * LEAFLET_COUNT),
+        **{f"param_{name}": value for name, value in p.__dict__.items()},
+    }
+    return mesh

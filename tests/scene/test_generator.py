@@ -1,0 +1,218 @@
+"""The valve generator: areas, attachment, symmetry, sector = part of the full valve, axes,
+normals, and the mesh file round trip (issue 4, items 1 and 5)."""
+import math
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+import numpy as np
+
+from valve_scene.mesh_io import read_mesh, write_mesh
+from valve_scene.valve_geometry import (ValveParameters, leaflet_rotation, leaflet_surface_area)
+from valve_scene.valve_mesh import RESOLUTIONS, build_valve_mesh
+
+P = ValveParameters()
+R = P.annulus_radius
+SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
+
+
+def triangle_areas(nodes, tris):
+    a, b, c = nodes[tris[:, 0]], nodes[tris[:, 1]], nodes[tris[:, 2]]
+    return 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+
+
+def unit_normals(nodes, tris):
+    a, b, c = nodes[tris[:, 0]], nodes[tris[:, 1]], nodes[tris[:, 2]]
+    n = np.cross(b - a, c - a)
+    return n / np.linalg.norm(n, axis=1)[:, None]
+
+
+def keyed(points, scale=1e9):
+    """Exact-match keys for coordinates (rounded to 1 nm)."""
+    return [tuple(k) for k in np.round(points * scale).astype(np.int64)]
+
+
+def triangle_keys(nodes, tris, oriented=True):
+    keys = set()
+    for t in tris:
+        corners = keyed(nodes[t])
+        if oriented:
+            i = corners.index(min(corners))   # rotate so the smallest corner leads
+            keys.add(tuple(corners[i:] + corners[:i]))
+        else:
+            keys.add(tuple(sorted(corners)))
+    return keys
+
+
+class LeafletArea(unittest.TestCase):
+    def test_mesh_area_converges_to_the_surface_area_at_second_order(self):
+        exact = leaflet_surface_area(P, order=64)
+        self.assertAlmostEqual(exact, leaflet_surface_area(P, order=48), delta=1e-9)
+        errors = []
+        for resolution in ("coarse", "medium", "fine"):
+            mesh = build_valve_mesh("full", resolution, "triangles")
+            ids = mesh.element_sets["leaflet_1_triangles"][1]
+            errors.append(abs(triangle_areas(mesh.nodes, mesh.triangles[ids]).sum() - exact))
+        self.assertLess(errors[2] / exact, 1e-3)
+        self.assertGreater(errors[0] / errors[1], 3.0)   # h^2: ratio 4 per halving
+        self.assertGreater(errors[1] / errors[2], 3.0)
+        # plausibility: a size-23 leaflet is a few cm^2
+        self.assertGreater(exact, 2.0e-4)
+        self.assertLess(exact, 4.0e-4)
+
+
+class FullValve(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.mesh = build_valve_mesh("full", "medium", "both")
+        cls.mid = cls.mesh.node_sets["triangle_nodes"]
+
+    def test_counts(self):
+        nu, nv = RESOLUTIONS["medium"]
+        self.assertEqual(len(self.mesh.triangles), 3 * nu * nv * 2)   # 8064
+        self.assertEqual(len(self.mesh.hexahedra), 3 * nu * nv)
+        self.assertEqual(len(self.mesh.node_sets["free_edge_midpoints"]), 3)
+        mid_attachment = np.intersect1d(self.mesh.node_sets["attachment"], self.mid)
+        self.assertEqual(len(mid_attachment), 3 * (nu + 1 + 2 * nv))  # base row + two tabs
+
+    def test_attachment_nodes_lie_on_the_stent_cylinder(self):
+        ids = np.intersect1d(self.mesh.node_sets["attachment"], self.mid)
+        x = self.mesh.nodes[ids]
+        np.testing.assert_allclose(np.hypot(x[:, 0], x[:, 1]), R, atol=1e-12)
+        self.assertAlmostEqual(x[:, 2].min(), 0.0, delta=1e-12)
+        self.assertAlmostEqual(x[:, 2].max(), P.commissure_height, delta=1e-12)
+        # and no other mid-surface node touches the stent
+        others = np.setdiff1d(self.mid, ids)
+        r = np.hypot(self.mesh.nodes[others, 0], self.mesh.nodes[others, 1])
+        self.assertLess(r.max(), R - 1e-6)
+
+    def test_free_edge_midpoints_on_the_leaflet_bisectors_near_the_axis(self):
+        x = self.mesh.nodes[self.mesh.node_sets["free_edge_midpoints"]]
+        for k, point in enumerate(x):
+            bisector = leaflet_rotation(k) @ np.array([1.0, 0.0, 0.0])
+            self.assertAlmostEqual(float(np.cross(bisector, point)[2]), 0.0, delta=1e-12)
+            # gap/2 from both coaptation planes
+            self.assertAlmostEqual(float(point @ bisector), 0.5 * P.coaptation_gap / math.sin(math.pi / 3), delta=1e-12)
+            self.assertAlmostEqual(point[2], P.free_edge_centre_height, delta=1e-12)
+
+    def test_three_fold_rotational_symmetry(self):
+        rotated = self.mesh.nodes @ leaflet_rotation(1).T
+        self.assertEqual(set(keyed(rotated)), set(keyed(self.mesh.nodes)))
+        self.assertEqual(triangle_keys(rotated, self.mesh.triangles), triangle_keys(self.mesh.nodes, self.mesh.triangles))
+        bottom_faces = self.mesh.hexahedra[:, :3]
+        self.assertEqual(triangle_keys(rotated, bottom_faces), triangle_keys(self.mesh.nodes, bottom_faces))
+
+    def test_mirror_symmetry_about_a_leaflet_bisector(self):
+        mirrored = self.mesh.nodes * np.array([1.0, -1.0, 1.0])
+        self.assertEqual(set(keyed(mirrored)), set(keyed(self.mesh.nodes)))
+        # a mirror reverses the vertex order, so compare unoriented triangles
+        self.assertEqual(triangle_keys(mirrored, self.mesh.triangles, oriented=False),
+                         triangle_keys(self.mesh.nodes, self.mesh.triangles, oriented=False))
+
+    def test_axes_are_unit_in_plane_and_orthogonal(self):
+        n = unit_normals(self.mesh.nodes, self.mesh.triangles)
+        for c, r in ((self.mesh.triangle_circumferential, self.mesh.triangle_radial),):
+            np.testing.assert_allclose(np.linalg.norm(c, axis=1), 1.0, atol=1e-12)
+            np.testing.assert_allclose(np.linalg.norm(r, axis=1), 1.0, atol=1e-12)
+            np.testing.assert_allclose(np.sum(c * r, axis=1), 0.0, atol=1e-12)
+            np.testing.assert_allclose(np.sum(c * n, axis=1), 0.0, atol=1e-12)
+            np.testing.assert_allclose(np.sum(r * n, axis=1), 0.0, atol=1e-12)
+            # right-handed (c, r, n): radial runs from the attachment toward the free edge
+            np.testing.assert_allclose(np.sum(np.cross(c, r) * n, axis=1), 1.0, atol=1e-12)
+        c, r = self.mesh.hexahedron_circumferential, self.mesh.hexahedron_radial
+        np.testing.assert_allclose(np.linalg.norm(c, axis=1), 1.0, atol=1e-12)
+        np.testing.assert_allclose(np.linalg.norm(r, axis=1), 1.0, atol=1e-12)
+        np.testing.assert_allclose(np.sum(c * r, axis=1), 0.0, atol=1e-12)
+
+    def test_axes_directions_at_the_leaflet_base(self):
+        # leaflet 0's lowest elements, at the bisector: circumferential = +y (increasing
+        # azimuth), radial = toward the axis and up
+        tri = self.mesh.element_sets["leaflet_0_triangles"][1]
+        centroids = self.mesh.nodes[self.mesh.triangles[tri]].mean(axis=1)
+        lowest = tri[np.argsort(centroids[:, 2])[:2]]
+        for e in lowest:
+            self.assertGreater(self.mesh.triangle_circumferential[e] @ np.array([0.0, 1.0, 0.0]), 0.95)
+            self.assertLess(self.mesh.triangle_radial[e][0], 0.0)
+
+    def test_normals_point_to_the_outflow_side(self):
+        n = unit_normals(self.mesh.nodes, self.mesh.triangles)
+        self.assertGreater(n[:, 2].min(), -1e-9)           # nowhere toward the ventricle
+        areas = triangle_areas(self.mesh.nodes, self.mesh.triangles)
+        # the projected (top-view) area is most of the annulus disk
+        projected = float((areas * n[:, 2]).sum())
+        self.assertGreater(projected, 0.95 * math.pi * R ** 2)
+        self.assertLess(projected, math.pi * R ** 2)
+
+    def test_hexahedra_are_the_triangles_extruded_by_the_thickness(self):
+        x = self.mesh.nodes
+        h = self.mesh.hexahedra
+        through = x[h[:, 4:]] - x[h[:, :4]]
+        np.testing.assert_allclose(np.linalg.norm(through, axis=2), P.thickness, rtol=1e-12)
+        # aortic face above the ventricular face: along the element normal
+        a, b, d = x[h[:, 0]], x[h[:, 1]], x[h[:, 3]]
+        normal = np.cross(b - a, d - a)
+        self.assertTrue(np.all(np.sum(through.mean(axis=1) * normal, axis=1) > 0))
+        # mid-surface of each brick = the shell quad
+        mid = 0.5 * (x[h[:, :4]] + x[h[:, 4:]])
+        self.assertEqual(set(keyed(mid.reshape(-1, 3), 1e8)),
+                         set(keyed(x[self.mid], 1e8)))
+
+
+class SectorValve(unittest.TestCase):
+    def test_sector_is_exactly_the_corresponding_part_of_the_full_valve(self):
+        full = build_valve_mesh("full", "coarse", "both")
+        sector = build_valve_mesh("sector", "coarse", "both")
+        self.assertEqual(len(sector.triangles) * 6, len(full.triangles))
+        self.assertEqual(len(sector.hexahedra) * 6, len(full.hexahedra))
+        full_triangles = {}
+        for e, t in enumerate(full.triangles):
+            full_triangles[tuple(keyed(full.nodes[t]))] = e
+        for e, t in enumerate(sector.triangles):
+            match = full_triangles.get(tuple(keyed(sector.nodes[t])))
+            self.assertIsNotNone(match)
+            np.testing.assert_array_equal(sector.triangle_circumferential[e], full.triangle_circumferential[match])
+            np.testing.assert_array_equal(sector.triangle_radial[e], full.triangle_radial[match])
+        full_hexes = {tuple(keyed(full.nodes[h])) for h in full.hexahedra}
+        for h in sector.hexahedra:
+            self.assertIn(tuple(keyed(sector.nodes[h])), full_hexes)
+        # the sector lies between the bisector (y = 0) and the coaptation plane
+        point, normal = sector.contact_planes["coaptation"]
+        self.assertGreater(float(((sector.nodes - point) @ normal).min()), 0.0)
+        self.assertGreater(sector.nodes[:, 1].min(), -1e-15)
+        on_plane = sector.node_sets["symmetry_leaflet_bisector"]
+        np.testing.assert_allclose(sector.nodes[on_plane, 1], 0.0, atol=1e-15)
+        self.assertIn(sector.node_sets["free_edge_midpoints"][0], on_plane)
+
+
+class MeshFile(unittest.TestCase):
+    def test_round_trip_and_command_line(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "sector.mesh.h5"
+            subprocess.run([sys.executable, "-m", "valve_scene.generate", "--variant", "sector",
+                            "--resolution", "coarse", "--out", str(path)], check=True, cwd=SCRIPTS,
+                           capture_output=True)
+            back = read_mesh(path)
+            again = build_valve_mesh("sector", "coarse", "both")
+            np.testing.assert_array_equal(back.nodes, again.nodes)
+            np.testing.assert_array_equal(back.triangles, again.triangles)
+            np.testing.assert_array_equal(back.hexahedra, again.hexahedra)
+            self.assertEqual(back.triangles.dtype, np.int64)
+            self.assertEqual(set(back.node_sets), set(again.node_sets))
+            self.assertEqual(back.element_sets["leaflet_0_hexahedra"][0], "hexahedron")
+            np.testing.assert_allclose(back.contact_planes["coaptation"][1], again.contact_planes["coaptation"][1])
+            self.assertIn("leaflet_bisector", back.symmetry_planes)
+            path2 = Path(tmp) / "x.mesh.h5"
+            write_mesh(back, path2)
+            np.testing.assert_array_equal(read_mesh(path2).triangle_radial, again.triangle_radial)
+
+    def test_bad_parameters_are_named(self):
+        with self.assertRaisesRegex(ValueError, "belly"):
+            build_valve_mesh("full", "coarse", params=ValveParameters(belly=1.5))
+        with self.assertRaisesRegex(ValueError, "resolution 'huge'"):
+            build_valve_mesh("full", "huge")
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,174 @@
+#pragma once
+// Internal forces of the rotation-free shell triangle (docs/solid_fe.md, "Shell element").
+// Per element: F = sum_a x_a (x) dN_a/dX, C_m = F^T F; curvature change kappa from the fold
+// angles of its three edges; at each Gauss point z through the thickness C(z) = C_m + 2 z kappa
+// (Kirchhoff), S(z) from the plane-stress material; N = int S dz, M = int z S dz;
+//   f_a = A0 F N dN_a   (membrane)   +   A0 sum_i (B^-T M)_i d theta_i / d x   (bending).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+
+#include "valvefsi/solid/hinge_angle.hpp"
+#include "valvefsi/solid/material.hpp"
+#include "valvefsi/solid/material_error.hpp"
+#include "valvefsi/solid/shell_model.hpp"
+
+namespace valvefsi::solid {
+
+// Wave-speed factor of the bending part in the element's highest frequency,
+// omega^2 = (2 c / L)^2 (1 + kBendingFrequencyFactor (h / L)^2); checked against the true
+// highest frequency of small meshes in tests/solid_fe/shell_stability_test.cpp.
+inline constexpr double kBendingFrequencyFactor = 5.0;
+
+struct ElementState {
+  Eigen::Matrix<double, 3, 2> deformation_gradient;  // F of the mid-surface (3x2)
+  Eigen::Matrix2d membrane_c;                        // C_m
+  Eigen::Matrix2d curvature;                         // kappa (2x2, reference frame)
+  Eigen::Vector3d fold_angle_change;                 // theta_i - theta0_i per edge slot
+  std::array<HingeSide, 3> own_side;
+  std::array<HingeSide, 3> neighbour_side;
+};
+
+inline ElementState element_kinematics(const ShellElement& el, const Eigen::Matrix3Xd& x) {
+  ElementState s;
+  s.deformation_gradient.setZero();
+  for (int a = 0; a < 3; ++a) {
+    s.deformation_gradient += x.col(el.nodes[a]) * el.shape_gradients.row(a);
+  }
+  s.membrane_c = s.deformation_gradient.transpose() * s.deformation_gradient;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d& xa = x.col(el.nodes[(i + 1) % 3]);
+    const Eigen::Vector3d& xb = x.col(el.nodes[(i + 2) % 3]);
+    switch (el.edge_kind[i]) {
+      case EdgeKind::interior: {
+        s.own_side[i] = hinge_side(xa, xb, x.col(el.nodes[i]), false);
+        s.neighbour_side[i] = hinge_side(xa, xb, x.col(el.opposite[i]), true);
+        s.fold_angle_change(i) = fold_angle(s.own_side[i], s.neighbour_side[i], xa, xb) -
+                                 el.reference_fold_angle[i];
+        break;
+      }
+      case EdgeKind::clamped: {
+        s.own_side[i] = hinge_side(xa, xb, x.col(el.nodes[i]), false);
+        s.fold_angle_change(i) = clamped_angle(s.own_side[i], el.reference_normal, xa, xb);
+        break;
+      }
+      case EdgeKind::free:
+        s.fold_angle_change(i) = 0.0;
+        break;
+    }
+  }
+  const Eigen::Vector3d k = el.curvature_from_angles * s.fold_angle_change;
+  s.curvature << k(0), 0.5 * k(2), 0.5 * k(2), k(1);
+  return s;
+}
+
+// Largest eigenvalue of a symmetric 2x2 matrix.
+inline double max_eigenvalue(const Eigen::Matrix2d& A) {
+  const double mean = 0.5 * (A(0, 0) + A(1, 1));
+  return mean + std::hypot(0.5 * (A(0, 0) - A(1, 1)), 0.5 * (A(0, 1) + A(1, 0)));
+}
+
+// Stable explicit step of one element from its current mid-surface stiffness.
+inline double element_stable_step(const ShellElement& el, const PlaneStressResponse& r,
+                                  const Eigen::Matrix2d& C, double density) {
+  // Reference-frame wave modulus: material part scaled by the stretch plus the stress part.
+  Eigen::Matrix3d mandel = r.tangent;
+  mandel.row(2) *= std::sqrt(2.0);
+  mandel.col(2) *= std::sqrt(2.0);
+  const double material = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                              mandel, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  const double modulus = max_eigenvalue(C) * material + std::max(0.0, max_eigenvalue(r.stress));
+  const double c = std::sqrt(std::max(modulus, 0.0) / density);
+  const double ratio = el.thickness / el.min_height;
+  const double omega = 2.0 * c / el.min_height * std::sqrt(1.0 + kBendingFrequencyFactor * ratio * ratio);
+  return omega > 0.0 ? 2.0 / omega : std::numeric_limits<double>::infinity();
+}
+
+struct ElementResult {
+  double strain_energy = 0;  // hyperelastic energy of the element (J)
+  double stable_step = std::numeric_limits<double>::infinity();
+};
+
+// Adds the element's internal force to `forces` (3 x nodes).
+template <class Law>
+ElementResult add_element_internal_force(const ShellModel& model, const ShellElement& el, const Law& law,
+                                         const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& forces,
+                                         bool estimate_step) {
+  const ElementState s = element_kinematics(el, x);
+  ElementResult result;
+  Eigen::Matrix2d N = Eigen::Matrix2d::Zero(), M = Eigen::Matrix2d::Zero();
+  const double half_thickness = 0.5 * el.thickness;
+  double energy_per_area = 0.0;
+  for (int k = 0; k < model.thickness_points; ++k) {
+    const double z = half_thickness * model.gauss_points[k];
+    const double w = half_thickness * model.gauss_weights[k];
+    const Eigen::Matrix2d C = s.membrane_c + 2.0 * z * s.curvature;
+    const PlaneStressResponse r = law.plane_stress(C, false);
+    N += w * r.stress;
+    M += (w * z) * r.stress;
+    energy_per_area += w * r.energy;
+  }
+  if (estimate_step) {
+    const PlaneStressResponse mid = law.plane_stress(s.membrane_c, true);
+    result.stable_step = element_stable_step(el, mid, s.membrane_c, model.density);
+  }
+  result.strain_energy = el.area * energy_per_area;
+
+  const Eigen::Matrix<double, 3, 2> FN = s.deformation_gradient * N;
+  for (int a = 0; a < 3; ++a) {
+    forces.col(el.nodes[a]).noalias() += el.area * (FN * el.shape_gradients.row(a).transpose());
+  }
+  const Eigen::Vector3d m_voigt{M(0, 0), M(1, 1), M(0, 1)};
+  const Eigen::Vector3d g = el.area * (el.curvature_from_angles.transpose() * m_voigt);
+  for (int i = 0; i < 3; ++i) {
+    if (el.edge_kind[i] == EdgeKind::free || g(i) == 0.0) continue;
+    const int ia = el.nodes[(i + 1) % 3], ib = el.nodes[(i + 2) % 3];
+    const HingeSide& own = s.own_side[i];
+    forces.col(el.nodes[i]) += g(i) * own.grad_opposite;
+    forces.col(ia) += g(i) * own.grad_start;
+    forces.col(ib) += g(i) * own.grad_end;
+    if (el.edge_kind[i] == EdgeKind::interior) {
+      const HingeSide& other = s.neighbour_side[i];
+      forces.col(el.opposite[i]) += g(i) * other.grad_opposite;
+      forces.col(ia) += g(i) * other.grad_start;
+      forces.col(ib) += g(i) * other.grad_end;
+    }
+  }
+  return result;
+}
+
+// Per-element results for output: maximum principal Cauchy stress and logarithmic strain
+// over the thickness points.
+struct ElementFieldValues {
+  double max_principal_stress = 0;  // Pa
+  double max_principal_log_strain = 0;
+};
+
+template <class Law>
+ElementFieldValues element_field_values(const ShellModel& model, const ShellElement& el, const Law& law,
+                                        const Eigen::Matrix3Xd& x) {
+  const ElementState s = element_kinematics(el, x);
+  ElementFieldValues out;
+  out.max_principal_stress = -std::numeric_limits<double>::infinity();
+  out.max_principal_log_strain = -std::numeric_limits<double>::infinity();
+  for (int k = 0; k < model.thickness_points; ++k) {
+    const double z = 0.5 * el.thickness * model.gauss_points[k];
+    const Eigen::Matrix2d C = s.membrane_c + 2.0 * z * s.curvature;
+    const PlaneStressResponse r = law.plane_stress(C, false);
+    // Cauchy stress sigma = F S F^T / J has the non-zero eigenvalues of S C / J.
+    const double J = r.thickness_stretch * std::sqrt(C.determinant());
+    const Eigen::Matrix2d SC = r.stress * C / J;
+    const double tr = SC.trace(), det = SC.determinant();
+    const double sigma_max = 0.5 * tr + std::sqrt(std::max(0.25 * tr * tr - det, 0.0));
+    out.max_principal_stress = std::max(out.max_principal_stress, sigma_max);
+    out.max_principal_log_strain = std::max(out.max_principal_log_strain, 0.5 * std::log(max_eigenvalue(C)));
+  }
+  return out;
+}
+
+}  // namespace valvefsi::solid

@@ -1,0 +1,103 @@
+#pragma once
+// Explicit central-difference dynamics of the shell model with lumped mass (docs/solid_fe.md).
+// The time loop is one call, advance_window(t_end, forces): FE-only runs call it with the
+// output times, the coupled participant with each coupling window's end. The whole state
+// is the copyable ShellState, so save/restore is assignment.
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "valvefsi/solid/material.hpp"
+#include "valvefsi/solid/shell_model.hpp"
+
+namespace valvefsi::solid {
+
+struct EnergyBalance {
+  double kinetic = 0;        // (J)
+  double internal_work = 0;  // work of the internal forces = stored + dissipated in the solid (J)
+  double strain_energy = 0;  // hyperelastic energy of the current state (J), for comparison
+  double external_work = 0;  // work of pressure and coupler forces (J)
+  double damping_work = 0;   // dissipated by mass-proportional damping (J)
+  double contact_work = 0;   // stored/dissipated in contact penalties (J)
+  double initial_kinetic = 0;
+  // KE + W_int + W_damp + W_contact - W_ext - KE0: zero for exact time integration.
+  double balance() const {
+    return kinetic + internal_work + damping_work + contact_work - external_work - initial_kinetic;
+  }
+  // |balance| relative to the largest energy term.
+  double relative_balance_error() const;
+};
+
+struct ShellState {
+  double time = 0;
+  std::int64_t step = 0;
+  Eigen::Matrix3Xd position;           // x at `time`
+  Eigen::Matrix3Xd half_step_velocity; // v at time - dt/2
+  Eigen::Matrix3Xd velocity;           // v at `time` (for output and kinetic energy)
+  Eigen::Matrix3Xd internal_force;     // at `position`
+  Eigen::Matrix3Xd external_force;     // at `position`, last evaluated
+  double last_step = 0;                // dt of the last step
+  double stable_step = 0;              // current stable step estimate (safety applied)
+  std::int64_t critical_element = -1;  // element that sets stable_step
+  EnergyBalance energy;
+};
+
+struct SymmetryConstraint {
+  std::int64_t node;
+  Eigen::Vector3d normal;  // the node keeps zero displacement along this unit normal
+};
+
+struct SolverOptions {
+  double time_step_safety = 0.8;        // fraction of the estimated critical step
+  double mass_damping_per_s = 0.0;      // alpha of the damping force alpha m v (off when 0)
+  int time_step_update_interval = 1;    // re-estimate the stable step every this many steps
+  double max_time_step = 1e-4;          // upper bound on dt (s)
+};
+
+class ShellSolver {
+ public:
+  ShellSolver(ShellModel model, Material material, SolverOptions options = {});
+
+  // Uniform transvalvular pressure dp(t) (Pa) on `elements` (all triangles when empty):
+  // nodal force = dp * (current area vector) / 3, i.e. along +normal for dp > 0.
+  void set_pressure(std::function<double(double)> pressure_Pa, std::vector<std::int64_t> elements = {});
+  void add_symmetry_constraints(const std::vector<SymmetryConstraint>& constraints);
+  void set_velocity(const Eigen::Matrix3Xd& velocity);  // initial condition (before the first step)
+
+  // Advances to exactly t_end under `nodal_forces` (3 x nodes, N; constant over the window)
+  // added to the pressure load. Throws MaterialStateError naming the element on failure.
+  void advance_window(double t_end, const Eigen::Matrix3Xd* nodal_forces = nullptr);
+
+  const ShellState& state() const { return state_; }
+  void restore(const ShellState& saved) { state_ = saved; }
+  const ShellModel& model() const { return model_; }
+  const Material& material() const { return material_; }
+  const SolverOptions& options() const { return options_; }
+  Eigen::Matrix3Xd displacement() const { return state_.position - model_.reference_positions; }
+
+  // Per-element maximum principal Cauchy stress (Pa) and logarithmic strain of the state.
+  void element_fields(Eigen::VectorXd& max_principal_stress, Eigen::VectorXd& max_principal_log_strain) const;
+
+ private:
+  void compute_internal_force(bool estimate_step);
+  void compute_external_force(double t, const Eigen::Matrix3Xd* nodal_forces);
+  void apply_constraints(Eigen::Matrix3Xd& field) const;
+  void update_kinetic_energy();
+
+  ShellModel model_;
+  Material material_;
+  SolverOptions options_;
+  std::function<double(double)> pressure_;
+  std::vector<std::int64_t> pressure_elements_;
+  std::vector<SymmetryConstraint> symmetry_;
+  std::vector<Eigen::Matrix3Xd> thread_forces_;  // per-thread accumulation, allocated once
+  Eigen::Matrix3Xd acceleration_;
+  bool internal_force_current_ = false;
+  ShellState state_;
+};
+
+}  // namespace valvefsi::solid

@@ -1,0 +1,267 @@
+#include "valvefsi/solid/shell_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+
+#include <fmt/format.h>
+#include <omp.h>
+
+#include "valvefsi/solid/material_error.hpp"
+#include "valvefsi/solid/shell_forces.hpp"
+
+namespace valvefsi::solid {
+
+double EnergyBalance::relative_balance_error() const {
+  const double scale = std::max({std::abs(kinetic), std::abs(internal_work), std::abs(external_work),
+                                 std::abs(damping_work), std::abs(contact_work), std::abs(initial_kinetic),
+                                 1e-300});
+  return std::abs(balance()) / scale;
+}
+
+ShellSolver::ShellSolver(ShellModel model, Material material, SolverOptions options)
+    : model_(std::move(model)), material_(std::move(material)), options_(options) {
+  if (!(options_.time_step_safety > 0.0 && options_.time_step_safety <= 1.0)) {
+    throw std::invalid_argument(fmt::format(
+        "solid: time_step_safety = {}: allowed (0, 1]", options_.time_step_safety));
+  }
+  if (options_.time_step_update_interval < 1) {
+    throw std::invalid_argument(fmt::format(
+        "solid: time_step_update_interval = {}: allowed >= 1", options_.time_step_update_interval));
+  }
+  const Eigen::Index n = model_.reference_positions.cols();
+  state_.position = model_.reference_positions;
+  state_.half_step_velocity = Eigen::Matrix3Xd::Zero(3, n);
+  state_.velocity = Eigen::Matrix3Xd::Zero(3, n);
+  state_.internal_force = Eigen::Matrix3Xd::Zero(3, n);
+  state_.external_force = Eigen::Matrix3Xd::Zero(3, n);
+  acceleration_ = Eigen::Matrix3Xd::Zero(3, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!(model_.nodal_mass(i) > 0.0)) {
+      throw std::invalid_argument(fmt::format("solid: node {} belongs to no element (zero mass)", i));
+    }
+  }
+}
+
+void ShellSolver::set_pressure(std::function<double(double)> pressure_Pa, std::vector<std::int64_t> elements) {
+  pressure_ = std::move(pressure_Pa);
+  if (elements.empty()) {
+    elements.resize(model_.elements.size());
+    for (std::size_t e = 0; e < elements.size(); ++e) elements[e] = static_cast<std::int64_t>(e);
+  }
+  for (const std::int64_t e : elements) {
+    if (e < 0 || e >= static_cast<std::int64_t>(model_.elements.size())) {
+      throw std::invalid_argument(fmt::format("solid: pressure element {} does not exist", e));
+    }
+  }
+  pressure_elements_ = std::move(elements);
+  internal_force_current_ = false;
+}
+
+void ShellSolver::add_symmetry_constraints(const std::vector<SymmetryConstraint>& constraints) {
+  for (const auto& c : constraints) symmetry_.push_back({c.node, c.normal.normalized()});
+}
+
+void ShellSolver::set_velocity(const Eigen::Matrix3Xd& velocity) {
+  state_.velocity = velocity;
+  state_.half_step_velocity = velocity;
+  apply_constraints(state_.velocity);
+  apply_constraints(state_.half_step_velocity);
+  internal_force_current_ = false;
+}
+
+void ShellSolver::apply_constraints(Eigen::Matrix3Xd& field) const {
+  for (const auto& c : symmetry_) {
+    auto col = field.col(c.node);
+    col -= col.dot(c.normal) * c.normal;
+  }
+  for (std::size_t i = 0; i < model_.fixed.size(); ++i) {
+    if (model_.fixed[i]) field.col(static_cast<Eigen::Index>(i)).setZero();
+  }
+}
+
+void ShellSolver::compute_internal_force(bool estimate_step) {
+  const int threads = omp_get_max_threads();
+  const Eigen::Index n = model_.reference_positions.cols();
+  if (static_cast<int>(thread_forces_.size()) != threads) {
+    thread_forces_.assign(static_cast<std::size_t>(threads), Eigen::Matrix3Xd::Zero(3, n));
+  }
+  const auto num_elements = static_cast<std::int64_t>(model_.elements.size());
+  double strain_energy = 0.0;
+  double min_step = std::numeric_limits<double>::infinity();
+  std::int64_t critical = -1;
+  std::string error;
+  const Eigen::Matrix3Xd& x = state_.position;
+  std::visit(
+      [&](const auto& law) {
+#pragma omp parallel
+        {
+          Eigen::Matrix3Xd& f = thread_forces_[static_cast<std::size_t>(omp_get_thread_num())];
+          f.setZero();
+          double local_energy = 0.0;
+          double local_step = std::numeric_limits<double>::infinity();
+          std::int64_t local_critical = -1;
+#pragma omp for schedule(static)
+          for (std::int64_t e = 0; e < num_elements; ++e) {
+            try {
+              const ElementResult r = add_element_internal_force(
+                  model_, model_.elements[static_cast<std::size_t>(e)], law, x, f, estimate_step);
+              local_energy += r.strain_energy;
+              if (r.stable_step < local_step) {
+                local_step = r.stable_step;
+                local_critical = e;
+              }
+            } catch (const MaterialStateError& ex) {
+#pragma omp critical(valvefsi_solid_error)
+              if (error.empty()) error = fmt::format("element {}: {}", e, ex.what());
+            }
+          }
+#pragma omp critical(valvefsi_solid_reduce)
+          {
+            strain_energy += local_energy;
+            if (local_step < min_step) {
+              min_step = local_step;
+              critical = local_critical;
+            }
+          }
+        }
+      },
+      material_);
+  if (!error.empty()) {
+    throw MaterialStateError(fmt::format("solid at t = {:.6g} s, step {}: {}", state_.time, state_.step, error));
+  }
+  state_.internal_force = thread_forces_[0];
+  for (std::size_t t = 1; t < thread_forces_.size(); ++t) state_.internal_force += thread_forces_[t];
+  state_.energy.strain_energy = strain_energy;
+  if (estimate_step) {
+    state_.stable_step = std::min(options_.time_step_safety * min_step, options_.max_time_step);
+    state_.critical_element = critical;
+  }
+  internal_force_current_ = true;
+}
+
+void ShellSolver::compute_external_force(double t, const Eigen::Matrix3Xd* nodal_forces) {
+  Eigen::Matrix3Xd& f = state_.external_force;
+  f.setZero();
+  if (pressure_) {
+    const double dp = pressure_(t);
+    if (dp != 0.0) {
+      const Eigen::Matrix3Xd& x = state_.position;
+      for (const std::int64_t e : pressure_elements_) {
+        const auto& nodes = model_.elements[static_cast<std::size_t>(e)].nodes;
+        const Eigen::Vector3d area_vector =
+            0.5 * (x.col(nodes[1]) - x.col(nodes[0])).cross(x.col(nodes[2]) - x.col(nodes[0]));
+        const Eigen::Vector3d share = (dp / 3.0) * area_vector;
+        for (int a = 0; a < 3; ++a) f.col(nodes[a]) += share;
+      }
+    }
+  }
+  if (nodal_forces != nullptr) {
+    if (nodal_forces->cols() != f.cols()) {
+      throw std::invalid_argument(fmt::format("solid: nodal forces for {} nodes, the mesh has {}",
+                                              nodal_forces->cols(), f.cols()));
+    }
+    f += *nodal_forces;
+  }
+}
+
+void ShellSolver::update_kinetic_energy() {
+  double kinetic = 0.0;
+  for (Eigen::Index i = 0; i < state_.velocity.cols(); ++i) {
+    kinetic += 0.5 * model_.nodal_mass(i) * state_.velocity.col(i).squaredNorm();
+  }
+  state_.energy.kinetic = kinetic;
+}
+
+void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_forces) {
+  if (t_end < state_.time) {
+    throw std::invalid_argument(
+        fmt::format("solid: advance_window to t = {} s, before the current time {} s", t_end, state_.time));
+  }
+  if (!internal_force_current_) {
+    compute_internal_force(true);
+    if (state_.step == 0) {
+      update_kinetic_energy();
+      state_.energy.initial_kinetic = state_.energy.kinetic;
+    }
+  }
+  const Eigen::ArrayXd inverse_mass = model_.nodal_mass.array().inverse();
+  const double alpha = options_.mass_damping_per_s;
+  Eigen::Matrix3Xd& x = state_.position;
+  Eigen::Matrix3Xd& v_half = state_.half_step_velocity;
+  Eigen::Matrix3Xd& a = acceleration_;
+
+  while (state_.time < t_end) {
+    compute_external_force(state_.time, nodal_forces);
+    a = (state_.external_force - state_.internal_force).array().rowwise() * inverse_mass.transpose();
+    apply_constraints(a);
+
+    double dt = state_.stable_step;
+    // Land exactly on t_end; avoid a sliver step by splitting the last two evenly.
+    const double remaining = t_end - state_.time;
+    if (remaining <= dt) {
+      dt = remaining;
+    } else if (remaining < 2.0 * dt) {
+      dt = 0.5 * remaining;
+    }
+    const double averaged_step = 0.5 * (state_.last_step + dt);
+    if (alpha > 0.0) {
+      // Central difference with damping force alpha m v at the full step (implicit in v).
+      v_half = ((1.0 - 0.5 * alpha * averaged_step) * v_half + averaged_step * a) /
+               (1.0 + 0.5 * alpha * averaged_step);
+    } else {
+      v_half += averaged_step * a;
+    }
+    apply_constraints(v_half);
+    const Eigen::Matrix3Xd dx = dt * v_half;
+    if (alpha > 0.0) {
+      for (Eigen::Index i = 0; i < x.cols(); ++i) {
+        state_.energy.damping_work += alpha * model_.nodal_mass(i) * v_half.col(i).dot(dx.col(i));
+      }
+    }
+    state_.energy.internal_work += 0.5 * (state_.internal_force.cwiseProduct(dx)).sum();
+    state_.energy.external_work += 0.5 * (state_.external_force.cwiseProduct(dx)).sum();
+    x += dx;
+    state_.time = (dt == remaining) ? t_end : state_.time + dt;
+    ++state_.step;
+    state_.last_step = dt;
+
+    const bool estimate = state_.step % options_.time_step_update_interval == 0;
+    compute_internal_force(estimate);
+    compute_external_force(state_.time, nodal_forces);
+    state_.energy.internal_work += 0.5 * (state_.internal_force.cwiseProduct(dx)).sum();
+    state_.energy.external_work += 0.5 * (state_.external_force.cwiseProduct(dx)).sum();
+    a = (state_.external_force - state_.internal_force).array().rowwise() * inverse_mass.transpose();
+    apply_constraints(a);
+    state_.velocity = v_half + 0.5 * dt * a;
+    update_kinetic_energy();
+  }
+}
+
+void ShellSolver::element_fields(Eigen::VectorXd& max_principal_stress,
+                                 Eigen::VectorXd& max_principal_log_strain) const {
+  const auto num_elements = static_cast<Eigen::Index>(model_.elements.size());
+  max_principal_stress.resize(num_elements);
+  max_principal_log_strain.resize(num_elements);
+  std::visit(
+      [&](const auto& law) {
+#pragma omp parallel for schedule(static)
+        for (Eigen::Index e = 0; e < num_elements; ++e) {
+          try {
+            const ElementFieldValues v =
+                element_field_values(model_, model_.elements[static_cast<std::size_t>(e)], law, state_.position);
+            max_principal_stress(e) = v.max_principal_stress;
+            max_principal_log_strain(e) = v.max_principal_log_strain;
+          } catch (const MaterialStateError&) {
+            // Output of a state the solver could not evaluate: mark it rather than stop.
+            max_principal_stress(e) = std::numeric_limits<double>::quiet_NaN();
+            max_principal_log_strain(e) = std::numeric_limits<double>::quiet_NaN();
+          }
+        }
+      },
+      material_);
+}
+
+}  // namespace valvefsi::solid

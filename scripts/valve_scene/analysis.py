@@ -1,0 +1,207 @@
+"""Kinematic metrics of a valve run, from arrays (node positions over time, triangles), as the
+reference reports them (definitions: docs/valve-scene.md, "Analysis").
+
+- free-edge midpoint radial position, mean over the leaflets (reference Fig. 5a);
+- geometric orifice area (GOA): the part of the annulus disk not covered by the top-view
+  projection of any leaflet triangle (reference Fig. 5b), by rasterisation;
+- leaflet profiles in a leaflet's bisecting plane (reference Fig. 6);
+- RVOT, RVCT, ET from the radial-position curve (reference Table 3).
+A 1/6 sector stands for the full valve: its GOA is measured inside its 60 deg wedge and
+multiplied by 6; its single free-edge midpoint is the mean by symmetry.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+DEFAULT_PIXELS_ACROSS = 1000   # raster resolution over the annulus diameter
+
+
+def free_edge_radial_position(nodes: np.ndarray, midpoint_ids) -> np.ndarray:
+    """Mean distance from the valve axis of the free-edge midpoints; nodes [..., N, 3]."""
+    x = np.asarray(nodes)[..., np.asarray(midpoint_ids), :]
+    return np.hypot(x[..., 0], x[..., 1]).mean(axis=-1)
+
+
+def _covered_pixels(xy: np.ndarray, triangles: np.ndarray, origin: float, h: float, n: int) -> np.ndarray:
+    """Boolean [n, n] (row = y, column = x): pixel centres inside the projection of any
+    triangle. Each triangle adds +1/-1 at the ends of its x-interval on every pixel row it
+    spans; a running sum along the rows then counts covering triangles per pixel."""
+    p = xy[triangles]                                   # [T, 3, 2]
+    ymin, ymax = p[:, :, 1].min(axis=1), p[:, :, 1].max(axis=1)
+    j0 = np.maximum(np.ceil((ymin - origin) / h - 0.5).astype(np.int64), 0)
+    j1 = np.minimum(np.floor((ymax - origin) / h - 0.5).astype(np.int64), n - 1)
+    rows = np.maximum(j1 - j0 + 1, 0)
+    tri = np.repeat(np.arange(len(triangles)), rows)
+    j = j0[tri] + (np.arange(rows.sum()) - np.repeat(np.cumsum(rows) - rows, rows))
+    y = origin + (j + 0.5) * h
+    crossings = []
+    for a, b in ((0, 1), (1, 2), (2, 0)):
+        # each edge in a canonical direction (lower node id first), so that the two triangles
+        # sharing it compute bit-identical crossings and leave no pixel between them
+        ia, ib = triangles[tri, a], triangles[tri, b]
+        pa, pb = xy[np.minimum(ia, ib)], xy[np.maximum(ia, ib)]
+        spans = ((pa[:, 1] <= y) & (y < pb[:, 1])) | ((pb[:, 1] <= y) & (y < pa[:, 1]))
+        dy = np.where(spans, pb[:, 1] - pa[:, 1], 1.0)
+        crossings.append(np.where(spans, pa[:, 0] + (y - pa[:, 1]) * (pb[:, 0] - pa[:, 0]) / dy, np.nan))
+    crossings = np.stack(crossings, axis=1)
+    valid = np.isfinite(crossings).sum(axis=1) >= 2
+    crossings, j = crossings[valid], j[valid]
+    x0, x1 = np.nanmin(crossings, axis=1), np.nanmax(crossings, axis=1)
+    i0 = np.maximum(np.ceil((x0 - origin) / h - 0.5).astype(np.int64), 0)
+    i1 = np.minimum(np.floor((x1 - origin) / h - 0.5).astype(np.int64), n - 1)
+    keep = i1 >= i0
+    diff = np.zeros((n, n + 1), dtype=np.int32)
+    np.add.at(diff, (j[keep], i0[keep]), 1)
+    np.add.at(diff, (j[keep], i1[keep] + 1), -1)
+    return np.cumsum(diff[:, :n], axis=1) > 0
+
+
+def geometric_orifice_area(nodes: np.ndarray, triangles: np.ndarray, annulus_radius: float,
+                           wedge_deg: tuple[float, float] | None = None,
+                           pixels_across: int = DEFAULT_PIXELS_ACROSS) -> float:
+    """GOA (m^2): area of the annulus disk r < R not covered by any triangle seen along z.
+    With wedge_deg = (a, b) only the wedge a <= azimuth <= b is measured and the result is
+    scaled by 360 / (b - a) (a sector run standing for the full valve).
+    Pixel-centre sampling with h = 2R / pixels_across: the error is a few boundary pixels,
+    about 1e-3 of a 1 cm^2 opening at the default (measured in tests/scene/test_analysis.py)."""
+    R = float(annulus_radius)
+    n = int(pixels_across)
+    h = 2.0 * R / n
+    centres = -R + (np.arange(n) + 0.5) * h
+    X, Y = np.meshgrid(centres, centres)                # [row = y, column = x]
+    inside = X * X + Y * Y < R * R
+    scale = 1.0
+    if wedge_deg is not None:
+        a, b = (math.radians(w) for w in wedge_deg)
+        phi = np.mod(np.arctan2(Y, X) - a, 2 * math.pi)
+        inside &= phi <= (b - a)
+        scale = 2 * math.pi / (b - a)
+    xy = np.asarray(nodes)[:, :2]
+    open_pixels = inside & ~_covered_pixels(xy, np.asarray(triangles), -R, h, n)
+    return scale * h * h * float(open_pixels.sum())
+
+
+def bisection_profile(nodes: np.ndarray, triangles: np.ndarray, azimuth_deg: float) -> np.ndarray:
+    """The leaflet's cut by the half-plane through the axis at the given azimuth, as an
+    ordered polyline [(radial coordinate, z)], from the lower end (the attachment base)
+    to the other (the free edge). Pass the triangles of one leaflet."""
+    a = math.radians(azimuth_deg)
+    direction = np.array([math.cos(a), math.sin(a), 0.0])
+    normal = np.array([-math.sin(a), math.cos(a), 0.0])
+    nodes = np.asarray(nodes)
+    d = nodes @ normal
+    tol = 1e-12 * max(1.0, float(np.abs(nodes).max()))
+    side = np.where(np.abs(d) <= tol, 0, np.sign(d)).astype(int)
+    points: dict = {}
+    segments = set()
+
+    def point_id(u: int, w: int):
+        if side[u] == 0:
+            key = ("v", u)
+            points[key] = nodes[u]
+        else:
+            key = ("e", min(u, w), max(u, w))
+            t = d[u] / (d[u] - d[w])
+            points[key] = nodes[u] + t * (nodes[w] - nodes[u])
+        return key
+
+    for tri in np.asarray(triangles):
+        ends = []
+        for u, w in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])):
+            if side[u] == 0:
+                ends.append(point_id(u, w))
+            elif side[u] * side[w] < 0:
+                ends.append(point_id(u, w))
+        ends = list(dict.fromkeys(ends))
+        if len(ends) == 2:
+            segments.add(tuple(sorted(ends)))
+    if not segments:
+        return np.empty((0, 2))
+    neighbours: dict = {}
+    for u, w in segments:
+        neighbours.setdefault(u, []).append(w)
+        neighbours.setdefault(w, []).append(u)
+    ends = [k for k, v in neighbours.items() if len(v) == 1] or list(neighbours)
+    start = min(ends, key=lambda k: points[k][2])
+    order, previous, current = [start], None, start
+    while True:
+        following = [k for k in neighbours[current] if k != previous]
+        if not following or following[0] == start:
+            break
+        previous, current = current, following[0]
+        order.append(current)
+    xyz = np.array([points[k] for k in order])
+    return np.stack([xyz @ direction, xyz[:, 2]], axis=1)
+
+
+@dataclass(frozen=True)
+class ValveEvents:
+    """Times (s) from the free-edge radial-position curve; levels are fractions of its range."""
+    opening_start: float   # first upward crossing of the low level
+    opening_end: float     # first upward crossing of the high level after it
+    closing_start: float   # last downward crossing of the high level before closing_end
+    closing_end: float     # last downward crossing of the low level
+    rvot: float            # rapid valve opening time = opening_end - opening_start
+    rvct: float            # rapid valve closing time = closing_end - closing_start
+    et: float              # ejection time = closing_end - opening_start
+
+
+def _crossings(t: np.ndarray, r: np.ndarray, level: float, upward: bool) -> np.ndarray:
+    if upward:
+        idx = np.flatnonzero((r[:-1] < level) & (r[1:] >= level))
+    else:
+        idx = np.flatnonzero((r[:-1] >= level) & (r[1:] < level))
+    frac = (level - r[idx]) / (r[idx + 1] - r[idx])
+    return t[idx] + frac * (t[idx + 1] - t[idx])
+
+
+def valve_events(t, radial_position, low: float = 0.1, high: float = 0.9) -> ValveEvents:
+    """RVOT, RVCT, ET over one cycle of the free-edge radial position r(t).
+    With r_min, r_max its extremes over the samples given, levels L = r_min + low (r_max - r_min)
+    and H = r_min + high (r_max - r_min): opening runs from the first upward crossing of L to
+    the next upward crossing of H; closing from the last downward crossing of H (before the
+    final closure) to the last downward crossing of L; ejection from opening start to closing
+    end. Crossing times are interpolated linearly between samples."""
+    t = np.asarray(t, dtype=float)
+    r = np.asarray(radial_position, dtype=float)
+    if t.ndim != 1 or t.shape != r.shape or len(t) < 3 or np.any(np.diff(t) <= 0):
+        raise ValueError("valve_events: t and radial_position must be 1-D, equally long (>= 3) and t increasing")
+    r_min, r_max = r.min(), r.max()
+    if not r_max > r_min:
+        raise ValueError("valve_events: the radial position never changes; the valve did not open")
+    lo, hi = r_min + low * (r_max - r_min), r_min + high * (r_max - r_min)
+    up_lo = _crossings(t, r, lo, True)
+    if len(up_lo) == 0:
+        raise ValueError(f"valve_events: r(t) never rises through {low:.0%} of its range (starts open?)")
+    opening_start = up_lo[0]
+    up_hi = _crossings(t, r, hi, True)
+    up_hi = up_hi[up_hi > opening_start]
+    down_lo = _crossings(t, r, lo, False)
+    if len(up_hi) == 0 or len(down_lo) == 0:
+        raise ValueError("valve_events: r(t) does not open and close within the samples given")
+    closing_end = down_lo[-1]
+    down_hi = _crossings(t, r, hi, False)
+    down_hi = down_hi[down_hi < closing_end]
+    opening_end, closing_start = up_hi[0], down_hi[-1]
+    return ValveEvents(opening_start, opening_end, closing_start, closing_end,
+                       opening_end - opening_start, closing_end - closing_start, closing_end - opening_start)
+
+
+def kinematics(times, node_history, triangles, midpoint_ids, annulus_radius, sector: bool = False,
+               pixels_across: int = DEFAULT_PIXELS_ACROSS) -> dict:
+    """Time series of the free-edge radial position and GOA, and the valve events, for
+    node_history [steps, N, 3]. A sector mesh is leaflet 0's half between azimuth 0 and 60 deg."""
+    times = np.asarray(times, dtype=float)
+    radial = free_edge_radial_position(node_history, midpoint_ids)
+    wedge = (0.0, 60.0) if sector else None
+    goa = np.array([geometric_orifice_area(x, triangles, annulus_radius, wedge, pixels_across) for x in node_history])
+    result = {"time_s": times, "free_edge_radial_position_m": radial, "goa_m2": goa}
+    try:
+        result["events"] = valve_events(times, radial)
+    except ValueError as error:
+        result["events"] = None
+        result["events_error"] = str(error)
+    return result

@@ -1,0 +1,171 @@
+"""Kinematic metrics on synthetic inputs with known answers (issue 4, item 5)."""
+import math
+import unittest
+
+import numpy as np
+
+from valve_scene.analysis import (bisection_profile, free_edge_radial_position, geometric_orifice_area,
+                                  kinematics, valve_events)
+from valve_scene.valve_geometry import ValveParameters, leaflet_point
+from valve_scene.valve_mesh import build_valve_mesh
+
+P = ValveParameters()
+R = P.annulus_radius
+
+
+def disk(radius, sides=128, z=0.0):
+    """A flat triangulated disk (fan around the centre)."""
+    phi = np.linspace(0, 2 * math.pi, sides, endpoint=False)
+    nodes = np.vstack([[0.0, 0.0, z], np.stack([radius * np.cos(phi), radius * np.sin(phi), np.full(sides, z)], 1)])
+    tris = np.array([[0, 1 + i, 1 + (i + 1) % sides] for i in range(sides)])
+    return nodes, tris
+
+
+def open_towards_wall(nodes, fraction_at_commissure_height):
+    """A deformation that commutes with the valve's symmetries: each point moves radially
+    toward the stent by a fraction of its distance to it that grows with height."""
+    x = nodes.copy()
+    rho = np.hypot(x[:, 0], x[:, 1])
+    alpha = fraction_at_commissure_height * np.clip(x[:, 2] / P.commissure_height, 0, 1)
+    factor = 1 + alpha * (R - rho) / rho
+    x[:, 0] *= factor
+    x[:, 1] *= factor
+    return x
+
+
+def closed_valve_goa(p: ValveParameters, cells_circumferential: int) -> float:
+    """Exact uncovered area of the undeformed generated valve: each leaflet projects onto its
+    120 deg wedge shrunk by gap/2 on both sides (area by integrating r^2/2 over azimuth),
+    less the slivers between its attachment chords and the stent circle."""
+    g, a = p.coaptation_gap, math.pi / 3
+    phi_max = p.leaflet_half_angle
+    wedge = R * R * phi_max - 0.25 * g * g * (1 / math.tan(a - phi_max) - 1 / math.tan(a))
+    dphi = 2 * phi_max / cells_circumferential
+    slivers = cells_circumferential * 0.5 * R * R * (dphi - math.sin(dphi))
+    return math.pi * R * R - 3 * (wedge - slivers)
+
+
+class OrificeArea(unittest.TestCase):
+    def test_no_leaflets_gives_the_annulus_area(self):
+        goa = geometric_orifice_area(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), R)
+        self.assertAlmostEqual(goa / (math.pi * R * R), 1.0, delta=1e-3)
+        sector = geometric_orifice_area(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), R, wedge_deg=(0, 60))
+        self.assertAlmostEqual(sector / (math.pi * R * R), 1.0, delta=2e-3)
+
+    def test_a_flat_disk_covering_the_annulus_gives_zero(self):
+        nodes, tris = disk(1.02 * R)
+        self.assertEqual(geometric_orifice_area(nodes, tris, R), 0.0)
+
+    def test_a_half_disk_leaves_half_open(self):
+        nodes, tris = disk(1.02 * R, sides=128)
+        keep = tris[(nodes[tris][:, :, 1].min(axis=1) >= -1e-15)]    # the fan triangles with y >= 0
+        goa = geometric_orifice_area(nodes, keep, R)
+        self.assertAlmostEqual(goa / (0.5 * math.pi * R * R), 1.0, delta=2e-3)
+
+    def test_closed_generated_valve_matches_its_exact_slit_area(self):
+        mesh = build_valve_mesh("full", "medium", "triangles")
+        exact = closed_valve_goa(P, 48)
+        goa = geometric_orifice_area(mesh.nodes, mesh.triangles, R, pixels_across=2000)
+        self.assertAlmostEqual(goa / exact, 1.0, delta=0.01)
+        self.assertLess(exact, 0.2e-4)     # nearly closed: < 0.2 cm^2 of 4.15 cm^2
+
+    def test_sector_stands_for_the_full_valve(self):
+        full = build_valve_mesh("full", "coarse", "triangles")
+        sector = build_valve_mesh("sector", "coarse", "triangles")
+        for fraction in (0.0, 0.5, 0.8):
+            xf = open_towards_wall(full.nodes, fraction)
+            xs = open_towards_wall(sector.nodes, fraction)
+            goa_full = geometric_orifice_area(xf, full.triangles, R)
+            goa_sector = geometric_orifice_area(xs, sector.triangles, R, wedge_deg=(0, 60))
+            self.assertAlmostEqual(goa_sector / goa_full, 1.0, delta=0.01)
+            self.assertAlmostEqual(free_edge_radial_position(xs, sector.node_sets["free_edge_midpoints"]),
+                                   free_edge_radial_position(xf, full.node_sets["free_edge_midpoints"]), delta=1e-12)
+        self.assertGreater(goa_full, 1e-4)    # opened to more than 1 cm^2
+
+
+class RadialPosition(unittest.TestCase):
+    def test_mean_over_leaflets_and_over_time(self):
+        nodes = np.zeros((2, 4, 3))
+        nodes[0, 1] = [3.0, 4.0, 1.0]       # r = 5
+        nodes[0, 2] = [0.0, -1.0, 0.0]      # r = 1
+        nodes[1, 1] = [6.0, 8.0, 1.0]
+        nodes[1, 2] = [0.0, -3.0, 0.0]
+        np.testing.assert_allclose(free_edge_radial_position(nodes, [1, 2]), [3.0, 6.5])
+
+
+class ValveEvents(unittest.TestCase):
+    @staticmethod
+    def trapezoid(t):
+        """closed 0.3 mm, opens 10->30 ms to 10 mm, closes 200->230 ms."""
+        return np.interp(t, [0.0, 0.010, 0.030, 0.200, 0.230, 0.8], [0.3, 0.3, 10.0, 10.0, 0.3, 0.3]) * 1e-3
+
+    def test_ramp_history_gives_its_known_times(self):
+        t = np.linspace(0.0, 0.8, 1601)
+        events = valve_events(t, self.trapezoid(t))
+        self.assertAlmostEqual(events.rvot, 0.8 * 0.020, delta=1e-9)
+        self.assertAlmostEqual(events.rvct, 0.8 * 0.030, delta=1e-9)
+        self.assertAlmostEqual(events.opening_start, 0.010 + 0.1 * 0.020, delta=1e-9)
+        self.assertAlmostEqual(events.closing_end, 0.200 + 0.9 * 0.030, delta=1e-9)
+        self.assertAlmostEqual(events.et, 0.227 - 0.012, delta=1e-9)
+
+    def test_flutter_below_the_levels_does_not_change_the_times(self):
+        t = np.linspace(0.0, 0.8, 8001)
+        r = self.trapezoid(t)
+        plateau = (t > 0.035) & (t < 0.195)
+        r = r + np.where(plateau, 0.5e-3 * np.sin(2 * math.pi * 80 * t), 0.0)  # flutter +-0.5 mm at 80 Hz
+        r_clean = self.trapezoid(t)
+        # same levels: rescale the clean curve's extremes to the fluttering one's
+        events = valve_events(t, r)
+        lo = r.min() + 0.1 * (r.max() - r.min())
+        hi = r.min() + 0.9 * (r.max() - r.min())
+        expected_open_start = 0.010 + (lo - 0.3e-3) / (9.7e-3) * 0.020
+        expected_open_end = 0.010 + (hi - 0.3e-3) / (9.7e-3) * 0.020
+        self.assertAlmostEqual(events.opening_start, expected_open_start, delta=2e-5)
+        self.assertAlmostEqual(events.opening_end, expected_open_end, delta=2e-5)
+        self.assertGreater(events.rvct, 0.0)
+        self.assertLess(abs(events.et - valve_events(t, r_clean).et), 1e-3)
+
+    def test_a_valve_that_never_opens_is_reported(self):
+        t = np.linspace(0, 0.8, 81)
+        with self.assertRaisesRegex(ValueError, "never changes"):
+            valve_events(t, np.full_like(t, 1e-3))
+
+    def test_kinematics_on_a_synthetic_opening_history(self):
+        sector = build_valve_mesh("sector", "coarse", "triangles")
+        times = np.linspace(0.0, 0.3, 31)
+        fractions = np.interp(times, [0, 0.01, 0.03, 0.2, 0.23, 0.3], [0, 0, 0.8, 0.8, 0, 0])
+        history = np.stack([open_towards_wall(sector.nodes, f) for f in fractions])
+        result = kinematics(times, history, sector.triangles, sector.node_sets["free_edge_midpoints"], R,
+                            sector=True, pixels_across=400)
+        self.assertGreater(result["goa_m2"].max(), 10 * result["goa_m2"][0])
+        self.assertAlmostEqual(result["events"].rvot, 0.016, delta=1e-9)   # r is linear in the fraction
+        self.assertAlmostEqual(result["events"].rvct, 0.024, delta=1e-9)
+
+
+class BisectionProfile(unittest.TestCase):
+    def test_profile_of_the_generated_leaflet_is_its_analytic_centre_line(self):
+        v = np.linspace(0, 1, 2001)
+        centre_line = leaflet_point(P, 0.0, v)[:, [0, 2]]    # (x = radial, z) at s = 0
+        full = build_valve_mesh("full", "medium", "triangles")
+        sector = build_valve_mesh("sector", "medium", "triangles")
+        for mesh, leaflet, azimuth in ((full, 0, 0.0), (full, 1, 120.0), (full, 2, 240.0), (sector, 0, 0.0)):
+            tris = mesh.triangles[mesh.element_sets[f"leaflet_{leaflet}_triangles"][1]]
+            profile = bisection_profile(mesh.nodes, tris, azimuth)
+            self.assertEqual(len(profile), 29)                # the 28 radial cells' nodes
+            np.testing.assert_allclose(profile[0], [R, 0.0], atol=1e-12)      # attachment base first
+            np.testing.assert_allclose(profile[-1], [P.free_edge_midpoint[0], P.free_edge_centre_height], atol=1e-12)
+            distance = np.min(np.linalg.norm(profile[:, None, :] - centre_line[None, :, :], axis=2), axis=1)
+            self.assertLess(distance.max(), 2e-5)              # within the 2001-sample spacing
+            self.assertTrue(np.all(np.diff(profile[:, 1]) > 0))  # ordered upward along the leaflet
+
+    def test_profile_through_crossing_edges(self):
+        # a tilted flat strip crossing y = 0 between nodes: the profile interpolates the edges
+        nodes = np.array([[1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [0.0, -1.0, 2.0], [0.0, 1.0, 2.0]])
+        tris = np.array([[0, 1, 3], [0, 3, 2]])
+        profile = bisection_profile(nodes, tris, 0.0)
+        np.testing.assert_allclose(profile[0], [1.0, 0.0])
+        np.testing.assert_allclose(profile[-1], [0.0, 2.0])
+
+
+if __name__ == "__main__":
+    unittest.main()

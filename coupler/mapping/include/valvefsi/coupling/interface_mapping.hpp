@@ -6,9 +6,14 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <memory>
 #include <string_view>
 
 namespace valvefsi::coupling {
+
+namespace detail {
+class RadialBasisSystem;
+}
 
 // The solid's interface surface: node positions (3 x n_nodes, m), cells (nodes_per_cell x n_cells,
 // 0-based; 3 = triangles in 3D, 2 = segments in 2D, z = 0), node areas (m^2; m in 2D).
@@ -25,12 +30,15 @@ struct MappingOptions {
   MappingMethod method = MappingMethod::nearest_projection;
   double rbf_support_radius = 0.0;   // m; compact-support Wendland C2 RBF; required for radial_basis
   bool rbf_linear_polynomial = true; // augment with 1, x, y, z so that linear fields are exact
+                                     // (false: the constant only, so rows still sum to one)
 };
 
 // A sparse matrix H (n_points x n_nodes) with rows summing to one, built once from the
 // reference configuration. Consistent (motion): u_points = H u_nodes. Conservative (loads):
 // f_nodes = H^T f_points, which preserves the total force (rows sum to 1) and the power
 // (f_nodes . v_nodes = f_points . (H v_nodes)).
+// For radial_basis, H = E A^-1 is dense in general: the mapping then applies it through a
+// sparse factorisation, and matrix() assembles H only when asked (small interfaces, tests).
 class InterfaceMapping {
  public:
   static InterfaceMapping build(const InterfaceMesh& solid_surface,
@@ -43,9 +51,10 @@ class InterfaceMapping {
   Eigen::Index node_count() const;
 
  private:
-  explicit InterfaceMapping(Eigen::SparseMatrix<double, Eigen::RowMajor> h);
-  Eigen::SparseMatrix<double, Eigen::RowMajor> h_;
-  Eigen::SparseMatrix<double, Eigen::ColMajor> h_transpose_storage_;  // H stored column-major: fast H^T f
+  InterfaceMapping(Eigen::SparseMatrix<double, Eigen::RowMajor> h,
+                   std::shared_ptr<const detail::RadialBasisSystem> radial_basis);
+  Eigen::SparseMatrix<double, Eigen::RowMajor> h_;  // empty for radial_basis (its system holds H)
+  std::shared_ptr<const detail::RadialBasisSystem> radial_basis_;
 };
 
 // "nearest-neighbor" | "nearest-projection" | "rbf"; throws std::invalid_argument naming the allowed values

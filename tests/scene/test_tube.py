@@ -1,0 +1,32 @@
+"""The ISO 5840-3 tube description (issue 4, item 2)."""
+import math
+import unittest
+
+from valve_scene.tube import TubeSetup
+
+
+class Tube(unittest.TestCase):
+    def test_reference_dimensions_and_fluid_volume(self):
+        setup = TubeSetup()
+        setup.validate()
+        parts = {p["name"]: p for p in setup.primitives()}
+        self.assertAlmostEqual(2 * parts["tube"]["radius"], 36.8e-3, delta=1e-12)
+        self.assertAlmostEqual(parts["outlet_plate"]["z"], 110e-3, delta=1e-12)
+        self.assertEqual(parts["gasket"]["inner_radius"], parts["skirt"]["radius"])
+        self.assertEqual(parts["gasket"]["outer_radius"], parts["tube"]["radius"])
+        # the reference's medium resolution: ~790,200 particles of 0.7 mm
+        particles = setup.fluid_volume() / 0.7e-3 ** 3
+        self.assertAlmostEqual(particles / 790200, 1.0, delta=0.02)
+        # the pressure taps lie between the plates and outside the valve
+        self.assertGreater(parts["upstream_tap"]["z"], parts["inlet_plate"]["z"])
+        self.assertLess(parts["downstream_tap"]["z"], parts["outlet_plate"]["z"])
+
+    def test_bad_dimensions_are_named(self):
+        with self.assertRaisesRegex(ValueError, "tube_diameter"):
+            TubeSetup(tube_diameter=20e-3).validate()
+        with self.assertRaisesRegex(ValueError, "downstream_tap_distance"):
+            TubeSetup(downstream_tap_distance=3 * 36.8e-3).validate()
+
+
+if __name__ == "__main__":
+    unittest.main()

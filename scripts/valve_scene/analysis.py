@@ -205,3 +205,42 @@ def kinematics(times, node_history, triangles, midpoint_ids, annulus_radius, sec
         result["events"] = None
         result["events_error"] = str(error)
     return result
+
+
+@dataclass(frozen=True)
+class FieldPeak:
+    """Largest value of a per-element field and where it sits on the undeformed leaflet."""
+    value: float
+    element: int
+    reference_centroid: np.ndarray   # (m)
+    region: str                      # "commissure", "attachment", "free edge" or "belly"
+
+
+def peak_with_location(values, reference_nodes, elements, node_sets, near: float = 1.0e-3,
+                       commissure_radius: float = 2.0e-3) -> FieldPeak:
+    """The maximum of a per-element field (e.g. max-principal stress or log strain) and the
+    leaflet region of its element, judged on the reference (undeformed) mesh: within
+    `commissure_radius` of a commissure top (the highest attachment nodes) -> "commissure";
+    else within `near` of the attachment line -> "attachment"; of the free edge -> "free
+    edge"; otherwise "belly"."""
+    values = np.asarray(values, dtype=float)
+    e = int(np.argmax(values))
+    nodes = np.asarray(reference_nodes)
+    centroid = nodes[np.asarray(elements)[e]].mean(axis=0)
+    attachment = nodes[node_sets["attachment"]]
+    free_edge = nodes[node_sets["free_edge"]]
+    z_top = attachment[:, 2].max()
+    commissure_tops = attachment[attachment[:, 2] >= z_top - 1e-9]
+
+    def distance(points):
+        return float(np.min(np.linalg.norm(points - centroid, axis=1)))
+
+    if distance(commissure_tops) <= commissure_radius:
+        region = "commissure"
+    elif distance(attachment) <= near:
+        region = "attachment"
+    elif distance(free_edge) <= near:
+        region = "free edge"
+    else:
+        region = "belly"
+    return FieldPeak(float(values[e]), e, centroid, region)

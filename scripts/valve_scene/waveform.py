@@ -103,7 +103,11 @@ def ventricular_knots() -> tuple[np.ndarray, np.ndarray]:
 
 
 def _normal_cdf(x: np.ndarray) -> np.ndarray:
-    return 0.5 * (1.0 + np.vectorize(math.erf)(x / math.sqrt(2.0)))
+    # beyond 9 standard deviations the CDF is 0 or 1 to double precision: skip erf there
+    result = (x > 0).astype(float)
+    near = np.abs(x) < 9.0
+    result[near] = 0.5 * (1.0 + np.vectorize(math.erf)(x[near] / math.sqrt(2.0)))
+    return result
 
 
 def _normal_pdf(x: np.ndarray) -> np.ndarray:

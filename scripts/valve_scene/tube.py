@@ -85,6 +85,21 @@ class TubeSetup:
         return total - gasket
 
 
+def skirt_top_height(azimuth, valve: ValveParameters | None = None) -> np.ndarray:
+    """z of the skirt's top edge at the given azimuths (rad): the attachment line of the
+    leaflet that covers the azimuth, and the commissure-tab top in the narrow gaps between
+    neighbouring leaflets' tabs, so that the skirt closes the stent up to the attachment."""
+    valve = valve or ValveParameters()
+    azimuth = np.asarray(azimuth, dtype=float)
+    sector = 2 * math.pi / 3
+    local = np.mod(azimuth + 0.5 * sector, sector) - 0.5 * sector   # azimuth from the nearest leaflet centre
+    s = local / valve.leaflet_half_angle
+    covered = np.abs(s) <= 1.0 + 1e-9   # tolerance: tab azimuths recomputed from coordinates
+    from .valve_geometry import attachment_point
+    z = attachment_point(valve, np.clip(s, -1.0, 1.0))[..., 2]
+    return np.where(covered, z, valve.commissure_height)
+
+
 def plot(setup: TubeSetup, path: Path, valve: ValveParameters | None = None) -> None:
     import matplotlib
     matplotlib.use("Agg")

@@ -30,3 +30,17 @@ class Tube(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class SkirtEdge(unittest.TestCase):
+    def test_skirt_top_follows_the_attachment_nodes(self):
+        import numpy as np
+        from valve_scene.tube import skirt_top_height
+        from valve_scene.valve_mesh import build_valve_mesh
+        mesh = build_valve_mesh("full", "coarse", "triangles")
+        x = mesh.nodes[mesh.node_sets["attachment"]]
+        base_row = x[x[:, 2] < mesh.description["param_commissure_height"] - mesh.description["param_tab_height"] + 1e-12]
+        phi = np.arctan2(base_row[:, 1], base_row[:, 0])
+        np.testing.assert_allclose(skirt_top_height(phi), base_row[:, 2], atol=1e-12)
+        gap = math.pi / 3   # the commissure between leaflets 0 and 1
+        self.assertEqual(float(skirt_top_height(gap)), mesh.description["param_commissure_height"])

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .valve_geometry import ValveParameters, leaflet_point
+from .valve_geometry import ValveParameters, attachment_point, leaflet_point
 
 
 @dataclass(frozen=True)
@@ -95,7 +95,6 @@ def skirt_top_height(azimuth, valve: ValveParameters | None = None) -> np.ndarra
     local = np.mod(azimuth + 0.5 * sector, sector) - 0.5 * sector   # azimuth from the nearest leaflet centre
     s = local / valve.leaflet_half_angle
     covered = np.abs(s) <= 1.0 + 1e-9   # tolerance: tab azimuths recomputed from coordinates
-    from .valve_geometry import attachment_point
     z = attachment_point(valve, np.clip(s, -1.0, 1.0))[..., 2]
     return np.where(covered, z, valve.commissure_height)
 

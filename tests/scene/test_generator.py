@@ -154,6 +154,15 @@ class FullValve(unittest.TestCase):
         a, b, d = x[h[:, 0]], x[h[:, 1]], x[h[:, 3]]
         normal = np.cross(b - a, d - a)
         self.assertTrue(np.all(np.sum(through.mean(axis=1) * normal, axis=1) > 0))
+        # every brick has a positive Jacobian at all eight corners (right-handed corner frames)
+        for corner, (e1, e2, up) in enumerate(((1, 3, 4), (2, 0, 5), (3, 1, 6), (0, 2, 7))):
+            for base, top_sign in ((corner, 1.0), (corner + 4, -1.0)):
+                origin = x[h[:, base]]
+                a = x[h[:, e1 + (base // 4) * 4]] - origin
+                b = x[h[:, e2 + (base // 4) * 4]] - origin
+                c = x[h[:, up - 4 if base >= 4 else up]] - origin
+                jac = np.einsum("ij,ij->i", np.cross(a, b), c) * top_sign
+                self.assertGreater(jac.min(), 0.0)
         # mid-surface of each brick = the shell quad
         mid = 0.5 * (x[h[:, :4]] + x[h[:, 4:]])
         self.assertEqual(set(keyed(mid.reshape(-1, 3), 1e8)),

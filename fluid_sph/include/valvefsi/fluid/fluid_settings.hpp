@@ -1,0 +1,38 @@
+#pragma once
+// Physical and numerical parameters of one fluid simulation (SI units throughout).
+#include <array>
+#include <limits>
+
+#include "valvefsi/fluid/kernels.hpp"
+#include "valvefsi/fluid/particles.hpp"
+
+namespace valvefsi::fluid {
+
+template <int D>
+struct FluidSettings {
+  double particle_spacing = 0.0;        // dp (m)
+  double smoothing_length_ratio = 1.3;  // h / dp
+  KernelType kernel = KernelType::cubic_spline;
+  double rest_density = 1056.0;         // rho0 (kg/m^3), blood
+  double dynamic_viscosity = 0.0035;    // mu (Pa s), blood
+  double sound_speed = 145.0;           // artificial c0 (m/s), the reference's value
+  double density_diffusion = 0.1;       // delta of the delta-SPH term (Molteni & Colagrossi 2009)
+  double artificial_viscosity = 0.0;    // alpha of Monaghan's artificial viscosity
+  Vec<D> gravity{};                     // body acceleration (m/s^2)
+  double cfl = 0.2;                     // Courant number of the acoustic and force limits
+  double max_time_step = std::numeric_limits<double>::infinity();  // s
+  int sort_interval = 1;                // re-sort particles by cell every this many steps
+  Vec<D> domain_lower{};                // particles leaving [lower, upper) on a non-periodic axis are lost
+  Vec<D> domain_upper{};
+  std::array<bool, D> periodic{};
+
+  double smoothing_length() const { return smoothing_length_ratio * particle_spacing; }
+  double support_radius() const { return 2.0 * smoothing_length(); }
+  double particle_mass() const {
+    double volume = 1.0;
+    for (int d = 0; d < D; ++d) volume *= particle_spacing;
+    return rest_density * volume;
+  }
+};
+
+}  // namespace valvefsi::fluid

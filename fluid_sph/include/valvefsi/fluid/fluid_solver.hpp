@@ -1,0 +1,58 @@
+#pragma once
+// The weakly compressible SPH solver: owns the particles, the cell grid and the moving
+// bodies, and advances them with a kick-drift-kick velocity-Verlet step.
+#include <cstddef>
+#include <vector>
+
+#include "valvefsi/fluid/cell_grid.hpp"
+#include "valvefsi/fluid/fluid_settings.hpp"
+#include "valvefsi/fluid/particles.hpp"
+#include "valvefsi/fluid/pressure_plate.hpp"
+
+namespace valvefsi::fluid {
+
+template <int D>
+class FluidSolver {
+ public:
+  // Wall particles with body k > 0 belong to plates[k - 1]; body 0 walls are fixed.
+  FluidSolver(const FluidSettings<D>& settings, Particles<D> particles, std::vector<PressurePlate<D>> plates = {});
+
+  // Advances by time_step() and then chooses the next time step.
+  void step();
+  // Steps until time() >= end_time (the last step is shortened to land on it).
+  void advance_to(double end_time);
+
+  double time() const { return time_; }
+  double time_step() const { return dt_; }
+  long step_count() const { return steps_; }
+  std::size_t lost_count() const { return lost_; }
+  const FluidSettings<D>& settings() const { return settings_; }
+  const Particles<D>& particles() const { return particles_; }
+  const CellGrid<D>& grid() const { return grid_; }
+  const std::vector<PressurePlate<D>>& plates() const { return plates_; }
+
+  // Force of the fluid on body k (0: fixed walls, k: plates[k-1]) at the last step that
+  // computed it: every step when plates exist, otherwise after request_body_forces().
+  const std::vector<Vec<D>>& body_forces() const { return body_forces_; }
+  void request_body_forces() { body_forces_requested_ = true; }
+
+ private:
+  void evaluate_rates();
+  void choose_time_step();
+
+  FluidSettings<D> settings_;
+  Particles<D> particles_;
+  std::vector<PressurePlate<D>> plates_;
+  CellGrid<D> grid_;
+  std::vector<Vec<D>> body_forces_;
+  std::vector<Vec<D>> body_acceleration_;
+  bool body_forces_requested_ = false;
+  double time_ = 0.0;
+  double dt_ = 0.0;
+  long steps_ = 0;
+  std::size_t lost_ = 0;
+  float max_speed_ = 0.0f;
+  float max_acceleration_ = 0.0f;
+};
+
+}  // namespace valvefsi::fluid

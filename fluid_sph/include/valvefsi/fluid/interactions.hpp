@@ -1,0 +1,35 @@
+#pragma once
+// The physics passes over particle pairs, each one idea:
+//   update_fluid_pressure  - the equation of state (eq. 5) for every fluid particle
+//   update_wall_state      - generalized wall condition of Adami, Hu & Adams (2012): wall
+//                            pressure and no-slip velocity extrapolated from the fluid
+//   compute_fluid_rates    - continuity (eq. 2) with delta-SPH diffusion, momentum with
+//                            pressure, laminar viscosity (eq. 3) and artificial viscosity
+//   compute_body_forces    - the force the fluid exerts on each wall body (action = reaction
+//                            of the pair forces of compute_fluid_rates)
+#include <cstddef>
+#include <vector>
+
+#include "valvefsi/fluid/cell_grid.hpp"
+#include "valvefsi/fluid/fluid_settings.hpp"
+#include "valvefsi/fluid/particles.hpp"
+
+namespace valvefsi::fluid {
+
+template <int D>
+void update_fluid_pressure(Particles<D>& particles, const FluidSettings<D>& settings);
+
+// body_acceleration[k]: acceleration of body k (0: fixed walls), enters the wall pressure.
+template <int D>
+void update_wall_state(Particles<D>& particles, const CellGrid<D>& grid, const FluidSettings<D>& settings,
+                       const std::vector<Vec<D>>& body_acceleration);
+
+template <int D>
+void compute_fluid_rates(Particles<D>& particles, const CellGrid<D>& grid, const FluidSettings<D>& settings);
+
+// Force (N; per unit depth in 2D) of the fluid on each body 0..body_count-1.
+template <int D>
+std::vector<Vec<D>> compute_body_forces(const Particles<D>& particles, const CellGrid<D>& grid,
+                                        const FluidSettings<D>& settings, std::size_t body_count);
+
+}  // namespace valvefsi::fluid

@@ -1,0 +1,164 @@
+#include "valvefsi/fluid/fluid_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "valvefsi/fluid/interactions.hpp"
+
+namespace valvefsi::fluid {
+namespace {
+
+template <int D>
+void check_settings(const FluidSettings<D>& s) {
+  auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw std::invalid_argument("fluid settings: " + what);
+  };
+  require(s.particle_spacing > 0, "particle_spacing = " + std::to_string(s.particle_spacing) + ": allowed > 0");
+  require(s.smoothing_length_ratio >= 0.5 && s.smoothing_length_ratio <= 4,
+          "smoothing_length_ratio = " + std::to_string(s.smoothing_length_ratio) + ": allowed 0.5 .. 4");
+  require(s.rest_density > 0, "rest_density = " + std::to_string(s.rest_density) + ": allowed > 0");
+  require(s.sound_speed > 0, "sound_speed = " + std::to_string(s.sound_speed) + ": allowed > 0");
+  require(s.dynamic_viscosity >= 0, "dynamic_viscosity = " + std::to_string(s.dynamic_viscosity) + ": allowed >= 0");
+  require(s.cfl > 0 && s.cfl <= 1, "cfl = " + std::to_string(s.cfl) + ": allowed in (0, 1]");
+}
+
+}  // namespace
+
+template <int D>
+FluidSolver<D>::FluidSolver(const FluidSettings<D>& settings, Particles<D> particles, std::vector<PressurePlate<D>> plates)
+    : settings_((check_settings(settings), settings)),
+      particles_(std::move(particles)),
+      plates_(std::move(plates)),
+      grid_(settings.domain_lower, settings.domain_upper, settings.support_radius(), settings.periodic),
+      body_forces_(plates_.size() + 1, Vec<D>{}),
+      body_acceleration_(plates_.size() + 1, Vec<D>{}) {
+  for (std::size_t i = 0; i < particles_.size(); ++i)
+    if (particles_.body[i] > plates_.size())
+      throw std::invalid_argument("fluid particles: body index " + std::to_string(particles_.body[i]) +
+                                  " has no pressure plate (plates: " + std::to_string(plates_.size()) + ")");
+  lost_ = grid_.wrap_and_mark_lost(particles_);
+  grid_.sort(particles_);
+  evaluate_rates();
+  choose_time_step();
+}
+
+template <int D>
+void FluidSolver<D>::evaluate_rates() {
+  update_fluid_pressure<D>(particles_, settings_);
+  for (std::size_t k = 0; k < plates_.size(); ++k)
+    for (int d = 0; d < D; ++d) body_acceleration_[k + 1][d] = plates_[k].acceleration * plates_[k].normal[d];
+  update_wall_state<D>(particles_, grid_, settings_, body_acceleration_);
+  compute_fluid_rates<D>(particles_, grid_, settings_);
+  if (!plates_.empty() || body_forces_requested_) {
+    body_forces_ = compute_body_forces<D>(particles_, grid_, settings_, plates_.size() + 1);
+    body_forces_requested_ = false;
+  }
+}
+
+template <int D>
+void FluidSolver<D>::step() {
+  const double dt = dt_;
+  const float half = static_cast<float>(0.5 * dt);
+  const float full = static_cast<float>(dt);
+  auto& p = particles_;
+  const auto n = static_cast<std::ptrdiff_t>(p.size());
+
+  // First kick (velocity half step, density predicted to the full step) and drift (eq. 4).
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    if (p.kind[i] != Kind::fluid) continue;
+    for (int d = 0; d < D; ++d) {
+      p.velocity[d][i] += half * p.acceleration[d][i];
+      p.viscous_velocity[d][i] = p.velocity[d][i];
+      p.position[d][i] += dt * static_cast<double>(p.velocity[d][i]);
+    }
+    p.density_excess[i] += full * p.density_rate[i];
+    p.density_rate_previous[i] = p.density_rate[i];
+  }
+  for (auto& plate : plates_) {
+    plate.velocity += 0.5 * dt * plate.acceleration;
+    plate.displacement += dt * plate.velocity;
+  }
+  if (!plates_.empty()) {
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t i = 0; i < n; ++i) {
+      if (p.kind[i] != Kind::wall || p.body[i] == 0) continue;
+      const auto& plate = plates_[p.body[i] - 1];
+      for (int d = 0; d < D; ++d) {
+        p.position[d][i] += dt * plate.velocity * plate.normal[d];
+        p.velocity[d][i] = static_cast<float>(plate.velocity * plate.normal[d]);
+      }
+    }
+  }
+  time_ += dt;
+
+  lost_ += grid_.wrap_and_mark_lost(p);
+  grid_.sort(p);
+  evaluate_rates();
+
+  for (std::size_t k = 0; k < plates_.size(); ++k) {
+    auto& plate = plates_[k];
+    plate.fluid_force = body_forces_[k + 1];
+    plate.acceleration = plate.acceleration_at(time_, plate.fluid_force);
+    plate.velocity += 0.5 * dt * plate.acceleration;
+  }
+
+  // Second kick: velocity to the full step, density corrected to the trapezoidal rule.
+  float max_speed2 = 0.0f, max_acc2 = 0.0f;
+#pragma omp parallel for schedule(static) reduction(max : max_speed2, max_acc2)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    if (p.kind[i] != Kind::fluid) continue;
+    float v2 = 0.0f, a2 = 0.0f;
+    for (int d = 0; d < D; ++d) {
+      p.velocity[d][i] += half * p.acceleration[d][i];
+      v2 += p.velocity[d][i] * p.velocity[d][i];
+      a2 += p.acceleration[d][i] * p.acceleration[d][i];
+    }
+    p.density_excess[i] += half * (p.density_rate[i] - p.density_rate_previous[i]);
+    max_speed2 = std::max(max_speed2, v2);
+    max_acc2 = std::max(max_acc2, a2);
+  }
+  max_speed_ = std::sqrt(max_speed2);
+  max_acceleration_ = std::sqrt(max_acc2);
+  ++steps_;
+  choose_time_step();
+}
+
+template <int D>
+void FluidSolver<D>::choose_time_step() {
+  const auto& s = settings_;
+  const double h = s.smoothing_length();
+  if (steps_ == 0) {
+    float a2 = 0.0f;
+    for (std::size_t i = 0; i < particles_.size(); ++i) {
+      if (particles_.kind[i] != Kind::fluid) continue;
+      float v2 = 0.0f, acc2 = 0.0f;
+      for (int d = 0; d < D; ++d) {
+        v2 += particles_.velocity[d][i] * particles_.velocity[d][i];
+        acc2 += particles_.acceleration[d][i] * particles_.acceleration[d][i];
+      }
+      max_speed_ = std::max(max_speed_, std::sqrt(v2));
+      a2 = std::max(a2, acc2);
+    }
+    max_acceleration_ = std::sqrt(a2);
+  }
+  double dt = s.cfl * h / (s.sound_speed + max_speed_);                        // acoustic
+  if (max_acceleration_ > 0) dt = std::min(dt, s.cfl * std::sqrt(h / max_acceleration_));  // force
+  if (s.dynamic_viscosity > 0) dt = std::min(dt, 0.125 * h * h * s.rest_density / s.dynamic_viscosity);  // viscous (Morris et al. 1997)
+  dt_ = std::min(dt, s.max_time_step);
+}
+
+template <int D>
+void FluidSolver<D>::advance_to(double end_time) {
+  while (time_ < end_time * (1.0 - 1e-12)) {
+    if (time_ + dt_ > end_time) dt_ = end_time - time_;
+    step();
+  }
+}
+
+template class FluidSolver<2>;
+template class FluidSolver<3>;
+
+}  // namespace valvefsi::fluid

@@ -1,0 +1,262 @@
+#include "valvefsi/fluid/interactions.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "valvefsi/fluid/equation_of_state.hpp"
+#include "valvefsi/fluid/kernels.hpp"
+#include "valvefsi/fluid/pair_loop.hpp"
+
+namespace valvefsi::fluid {
+namespace {
+
+// Settings turned into the float constants the pair loops use.
+template <int D>
+struct PairConstants {
+  float mass, rest_density, h, support2, two_mu, alpha_c0, eta2, diffusion, hydrostatic;
+  std::array<float, D> gravity;
+  explicit PairConstants(const FluidSettings<D>& s)
+      : mass(static_cast<float>(s.particle_mass())),
+        rest_density(static_cast<float>(s.rest_density)),
+        h(static_cast<float>(s.smoothing_length())),
+        support2(static_cast<float>(s.support_radius() * s.support_radius())),
+        two_mu(static_cast<float>(2.0 * s.dynamic_viscosity)),
+        alpha_c0(static_cast<float>(s.artificial_viscosity * s.sound_speed)),
+        eta2(static_cast<float>(0.01 * s.smoothing_length() * s.smoothing_length())),
+        diffusion(static_cast<float>(2.0 * s.density_diffusion * s.smoothing_length() * s.sound_speed)),
+        hydrostatic(static_cast<float>(s.rest_density / (s.sound_speed * s.sound_speed))) {
+    for (int d = 0; d < D; ++d) gravity[d] = static_cast<float>(s.gravity[d]);
+  }
+};
+
+// Raw views of the particle arrays, so the inner loops see plain restrict-free pointers.
+template <int D>
+struct ParticleView {
+  std::array<const float*, D> x;
+  std::array<const float*, D> v, vv;
+  const float* fluid;
+  const float* excess;
+  const float* inverse_density;
+  const float* pressure;
+  const Kind* kind;
+  explicit ParticleView(const Particles<D>& p) : excess(p.density_excess.data()), inverse_density(p.inverse_density.data()), pressure(p.pressure.data()), kind(p.kind.data()) {
+    fluid = p.fluid_mask.data();
+    for (int d = 0; d < D; ++d) {
+      x[d] = p.local_position[d].data();
+      v[d] = p.velocity[d].data();
+      vv[d] = p.viscous_velocity[d].data();
+    }
+  }
+};
+
+struct Rates3 {
+  float acc[3] = {0.0f, 0.0f, 0.0f};
+  float continuity = 0.0f;
+  float diffusion = 0.0f;
+};
+
+// Sums over the neighbour segments of particle a:
+//   continuity:  sum_b (v_a - v_b) . grad_a W_ab                      (eq. 2, times m)
+//   momentum:    sum_b [-(p_a + p_b)/(rho_a rho_b) grad_a W_ab          (eq. 3, pressure)
+//                       + (mu_a + mu_b)/(rho_a rho_b) r.grad W / r^2 v_ab (eq. 3, viscosity)
+//                       - Pi_ab grad_a W_ab]                            (artificial viscosity)
+//   diffusion:   sum_b 2 (rho_b - rho_a - rho_ba^H) r_ba.grad_a W / r^2 / rho_b over fluid b
+//                (Molteni & Colagrossi 2009 with the hydrostatic part rho0 g.r_ba / c0^2
+//                removed, as Fourtakas et al. 2019 do, so a resting column stays at rest).
+// OnlyFluidNeighbours restricts the sum to fluid b (used for the force on walls).
+// The artificial viscosity uses 1/rho_bar = (1/rho_a + 1/rho_b)/2 instead of
+// 2/(rho_a + rho_b): equal to second order in the (sub-percent) density variation, and it
+// keeps divisions out of the loop.
+template <int D, bool WithArtificialViscosity, bool OnlyFluidNeighbours, class Kernel>
+inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, const Kernel& W, std::uint32_t a,
+                        const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments, int segment_count) {
+  const float excess_a = p.excess[a];
+  const float inv_a = p.inverse_density[a];
+  const float p_a = p.pressure[a];
+  float va[3] = {0, 0, 0}, vva[3] = {0, 0, 0};
+  for (int d = 0; d < D; ++d) {
+    va[d] = p.v[d][a];
+    vva[d] = p.vv[d][a];
+  }
+  float ax = 0, ay = 0, az = 0, cont = 0, diff = 0;
+  for (int s = 0; s < segment_count; ++s) {
+    const auto& seg = segments[s];
+    float xa[3] = {0, 0, 0};
+    for (int d = 0; d < D; ++d) xa[d] = p.x[d][a] - static_cast<float>(seg.shift[d]);
+    const float* x0 = p.x[0];
+    const float* x1 = p.x[1];
+    const float* x2 = p.x[D - 1];
+    const float* v0 = p.v[0];
+    const float* v1 = p.v[1];
+    const float* v2 = p.v[D - 1];
+    const float* w0 = p.vv[0];
+    const float* w1 = p.vv[1];
+    const float* w2 = p.vv[D - 1];
+    const float* ex = p.excess;
+    const float* inv = p.inverse_density;
+    const float* pr = p.pressure;
+    const float* fluid = p.fluid;
+#pragma omp simd reduction(+ : ax, ay, az, cont, diff)
+    for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
+      const float dx = xa[0] - x0[b];
+      const float dy = xa[1] - x1[b];
+      const float dz = D == 3 ? xa[2] - x2[b] : 0.0f;
+      const float r2 = dx * dx + dy * dy + dz * dz;
+      const float F = W.gradient_factor(std::sqrt(r2));  // zero beyond the support
+      const float is_fluid = fluid[b];
+      const float weight = OnlyFluidNeighbours ? F * is_fluid : F;
+      const float inv_b = inv[b];
+      const float inv_rr = inv_a * inv_b;
+      const float dvx = va[0] - v0[b], dvy = va[1] - v1[b], dvz = D == 3 ? va[2] - v2[b] : 0.0f;
+      const float vdx = dvx * dx + dvy * dy + dvz * dz;
+      cont += vdx * weight;
+      float radial = -(p_a + pr[b]) * inv_rr;
+      if constexpr (WithArtificialViscosity) {
+        const float mu_ab = k.h * std::min(vdx, 0.0f) / (r2 + k.eta2);
+        radial += k.alpha_c0 * mu_ab * 0.5f * (inv_a + inv_b);
+      }
+      radial *= weight;
+      const float viscous = k.two_mu * inv_rr * weight;
+      ax += radial * dx + viscous * (vva[0] - w0[b]);
+      ay += radial * dy + viscous * (vva[1] - w1[b]);
+      if constexpr (D == 3) az += radial * dz + viscous * (vva[2] - w2[b]);
+      float g_dot_rba = -(k.gravity[0] * dx + k.gravity[1] * dy);
+      if constexpr (D == 3) g_dot_rba -= k.gravity[D - 1] * dz;
+      diff += is_fluid * (ex[b] - excess_a - k.hydrostatic * g_dot_rba) * (-F) * inv_b;
+    }
+  }
+  Rates3 r;
+  r.acc[0] = ax;
+  r.acc[1] = ay;
+  r.acc[2] = az;
+  r.continuity = cont;
+  r.diffusion = diff;
+  return r;
+}
+
+}  // namespace
+
+template <int D>
+void update_fluid_pressure(Particles<D>& p, const FluidSettings<D>& s) {
+  const LinearMieGruneisen eos{s.rest_density, s.sound_speed};
+  const auto n = static_cast<std::ptrdiff_t>(p.size());
+  const float bulk = static_cast<float>(eos.bulk_modulus());
+  const float rho0 = static_cast<float>(s.rest_density);
+  float* pressure = p.pressure.data();
+  const float* excess = p.density_excess.data();
+  const Kind* kind = p.kind.data();
+  float* inverse = p.inverse_density.data();
+#pragma omp parallel for simd schedule(static)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    if (kind[i] == Kind::fluid) {
+      inverse[i] = 1.0f / (rho0 + excess[i]);
+      pressure[i] = bulk * excess[i] * inverse[i];  // eq. 5 with s = 0, Gamma0 = 0
+    }
+  }
+}
+
+template <int D>
+void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s,
+                       const std::vector<Vec<D>>& body_acceleration) {
+  const LinearMieGruneisen eos{s.rest_density, s.sound_speed};
+  const ParticleView<D> view(p);
+  const float rho0 = static_cast<float>(s.rest_density);
+  with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
+    for_each_particle_with_neighbours<D>(grid, [&](std::uint32_t w, const auto& segments, int count) {
+      if (p.kind[w] != Kind::wall) return;
+      float sum_w = 0, sum_p = 0;
+      float sum_rho_r[3] = {0, 0, 0}, sum_v[3] = {0, 0, 0};
+      for (int sidx = 0; sidx < count; ++sidx) {
+        const auto& seg = segments[sidx];
+        float xw[3] = {0, 0, 0};
+        for (int d = 0; d < D; ++d) xw[d] = view.x[d][w] - static_cast<float>(seg.shift[d]);
+        for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
+          if (view.kind[b] != Kind::fluid) continue;
+          float dx[3] = {0, 0, 0};
+          float r2 = 0;
+          for (int d = 0; d < D; ++d) {
+            dx[d] = xw[d] - view.x[d][b];
+            r2 += dx[d] * dx[d];
+          }
+          const float wk = W.value(std::sqrt(r2));
+          if (wk <= 0.0f) continue;
+          const float rho_b = rho0 + view.excess[b];
+          sum_w += wk;
+          sum_p += view.pressure[b] * wk;
+          for (int d = 0; d < D; ++d) {
+            sum_rho_r[d] += rho_b * dx[d] * wk;
+            sum_v[d] += view.v[d][b] * wk;
+          }
+        }
+      }
+      // Adami et al. 2012, eq. 27: p_w = (sum p_f W + (g - a_w) . sum rho_f r_wf W) / sum W;
+      // no-slip by the extrapolated velocity, v_w^visc = 2 v_w - v~ (their eq. 22-23).
+      const auto& a_w = body_acceleration[p.body[w]];
+      if (sum_w > 0.0f) {
+        double pw = sum_p;
+        for (int d = 0; d < D; ++d) pw += (s.gravity[d] - a_w[d]) * sum_rho_r[d];
+        pw /= sum_w;
+        p.pressure[w] = static_cast<float>(pw);
+        p.density_excess[w] = static_cast<float>(eos.density_excess(pw));
+        p.inverse_density[w] = static_cast<float>(1.0 / (s.rest_density + eos.density_excess(pw)));
+        for (int d = 0; d < D; ++d) p.viscous_velocity[d][w] = 2.0f * p.velocity[d][w] - sum_v[d] / sum_w;
+      } else {
+        p.pressure[w] = 0.0f;
+        p.density_excess[w] = 0.0f;
+        p.inverse_density[w] = 1.0f / rho0;
+        for (int d = 0; d < D; ++d) p.viscous_velocity[d][w] = p.velocity[d][w];
+      }
+    });
+  });
+}
+
+template <int D>
+void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s) {
+  const PairConstants<D> k(s);
+  const ParticleView<D> view(p);
+  with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
+    for_each_particle_with_neighbours<D>(grid, [&](std::uint32_t a, const auto& segments, int count) {
+      if (p.kind[a] != Kind::fluid) return;
+      const Rates3 r = k.alpha_c0 > 0 ? pair_sums<D, true, false>(view, k, W, a, segments, count)
+                                      : pair_sums<D, false, false>(view, k, W, a, segments, count);
+      for (int d = 0; d < D; ++d) p.acceleration[d][a] = k.mass * r.acc[d] + k.gravity[d];
+      p.density_rate[a] = k.mass * (r.continuity + k.diffusion * r.diffusion);
+    });
+  });
+}
+
+template <int D>
+std::vector<Vec<D>> compute_body_forces(const Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s,
+                                        std::size_t body_count) {
+  const PairConstants<D> k(s);
+  const ParticleView<D> view(p);
+  const int threads = omp_get_max_threads();
+  std::vector<double> per_thread(static_cast<std::size_t>(threads) * body_count * D, 0.0);
+  with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
+    for_each_particle_with_neighbours<D>(grid, [&](std::uint32_t w, const auto& segments, int count) {
+      if (p.kind[w] != Kind::wall || p.body[w] >= body_count) return;
+      const Rates3 r = k.alpha_c0 > 0 ? pair_sums<D, true, true>(view, k, W, w, segments, count)
+                                      : pair_sums<D, false, true>(view, k, W, w, segments, count);
+      double* f = per_thread.data() + (static_cast<std::size_t>(omp_get_thread_num()) * body_count + p.body[w]) * D;
+      for (int d = 0; d < D; ++d) f[d] += static_cast<double>(k.mass) * k.mass * r.acc[d];
+    });
+  });
+  std::vector<Vec<D>> forces(body_count, Vec<D>{});
+  for (int t = 0; t < threads; ++t)
+    for (std::size_t b = 0; b < body_count; ++b)
+      for (int d = 0; d < D; ++d) forces[b][d] += per_thread[(static_cast<std::size_t>(t) * body_count + b) * D + d];
+  return forces;
+}
+
+template void update_fluid_pressure<2>(Particles<2>&, const FluidSettings<2>&);
+template void update_fluid_pressure<3>(Particles<3>&, const FluidSettings<3>&);
+template void update_wall_state<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, const std::vector<Vec<2>>&);
+template void update_wall_state<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, const std::vector<Vec<3>>&);
+template void compute_fluid_rates<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&);
+template void compute_fluid_rates<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&);
+template std::vector<Vec<2>> compute_body_forces<2>(const Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, std::size_t);
+template std::vector<Vec<3>> compute_body_forces<3>(const Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, std::size_t);
+
+}  // namespace valvefsi::fluid

@@ -158,6 +158,23 @@ void MessageChannel::send_locked(const std::string& peer, protocol::Envelope& en
   }
 }
 
+void MessageChannel::send_raw_for_testing(const std::string& peer, const std::string& bytes) {
+  std::lock_guard lock(mutex_);
+  if (is_router_) socket_.send(zmq::buffer(peer), zmq::send_flags::sndmore);
+  socket_.send(zmq::buffer(bytes), zmq::send_flags::none);
+}
+
+bool MessageChannel::try_send(const std::string& peer, protocol::Envelope envelope) noexcept {
+  try {
+    std::lock_guard lock(mutex_);
+    if (closed_) return false;
+    send_locked(peer, envelope, false);
+    return true;
+  } catch (...) {
+    return false;
+  }
+}
+
 protocol::Envelope MessageChannel::receive_from(const std::string& peer) {
   return receive_matching(&peer, std::nullopt)->envelope;
 }
@@ -235,6 +252,7 @@ void MessageChannel::accept(const std::string& peer, const zmq::message_t& paylo
   try {
     auto envelope = decode_envelope(payload.data(), payload.size(), describe(peer), describe(local_name_));
     if (envelope.has_heartbeat()) return;
+    if (envelope.has_finish()) it->second.watched = false;  // a goodbye: its silence from now on is expected
     inbox_.push_back(Incoming{peer, std::move(envelope)});
   } catch (const ProtocolError&) {
     record_fault(std::current_exception());
@@ -246,7 +264,9 @@ void MessageChannel::send_heartbeats_if_due(Clock::time_point now) {
   next_heartbeat_ = now + duration_cast<Clock::duration>(liveness_.heartbeat_interval);
   const double wall = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
   for (const auto& [name, state] : peers_) {
-    if (!state.watched || (is_router_ && !state.last_heard)) continue;  // a ROUTER can only reach peers it heard
+    // A ROUTER can only reach peers it heard and stops at their goodbye; a DEALER keeps its
+    // coupler informed until it closes (it may write output for a while after Finish).
+    if (is_router_ && (!state.watched || !state.last_heard)) continue;
     protocol::Envelope heartbeat;
     heartbeat.mutable_heartbeat()->set_wall_time(wall);
     try {

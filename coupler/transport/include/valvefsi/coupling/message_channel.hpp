@@ -74,6 +74,10 @@ class MessageChannel {
   // Sends one message. Throws PeerLost when `peer` is not connected or cannot take the
   // message within peer_timeout. The DEALER ignores `peer` (it has one).
   void send(const std::string& peer, protocol::Envelope envelope);
+  // Sends `bytes` as they are, with no envelope: only for tests that inject malformed messages.
+  void send_raw_for_testing(const std::string& peer, const std::string& bytes);
+  // As send, but never waits or throws: for Abort messages to peers that may be gone.
+  bool try_send(const std::string& peer, protocol::Envelope envelope) noexcept;
   // Next message from `peer` (messages from other peers are kept for later). Throws PeerLost
   // when any watched peer is lost, ProtocolError for a malformed/foreign-version message,
   // RunAborted when any peer sent Abort.

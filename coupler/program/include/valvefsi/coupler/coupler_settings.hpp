@@ -1,0 +1,40 @@
+#pragma once
+// Everything the coupler program needs, taken from a case's `coupling` and `run` parts
+// (proto/coupling_case.proto) and the command line.
+
+#include <filesystem>
+#include <string>
+
+#include "case.pb.h"
+#include "valvefsi/coupling/acceleration.hpp"
+#include "valvefsi/coupling/interface_mapping.hpp"
+#include "valvefsi/coupling/message_channel.hpp"
+
+namespace valvefsi::coupler {
+
+enum class SchemeKind { serial_explicit, parallel_explicit, serial_implicit };
+
+struct CouplerSettings {
+  SchemeKind scheme = SchemeKind::serial_explicit;
+  coupling::AccelerationOptions acceleration;
+  double relative_tolerance = 1e-4;
+  int max_iterations = 50;
+  double window_size = 1e-3;   // s, the largest window
+  double end_time = 0.0;       // s
+  coupling::MappingOptions mapping;
+  std::string endpoint;
+  coupling::LivenessSettings liveness;
+  std::filesystem::path output_dir;
+  std::filesystem::path series_file;
+  int series_flush_rows = 50;
+};
+
+// "serial-explicit", "parallel-explicit", "serial-implicit/iqn-ils" (the acceleration is part
+// of an implicit scheme's name), as reported to participants and in logs.
+std::string scheme_label(const CouplerSettings& settings);
+
+// From a loaded (checked, defaults filled) case. `output_dir` is the run's folder (the
+// command line's --output, or run.output_dir); the endpoint follows resolve_endpoint().
+CouplerSettings settings_from_case(const cases::Case& run_case, const std::filesystem::path& output_dir);
+
+}  // namespace valvefsi::coupler

@@ -1,0 +1,51 @@
+#pragma once
+// The coupling schemes: the order in which the fluid and the solid advance through each
+// window and what each receives (docs/coupling.md has the diagrams).
+//   serial explicit   : solid state at the window start -> fluid -> loads -> solid
+//   parallel explicit : fluid (solid state at the start) and solid (previous window's loads) at once
+//   serial implicit   : serial, repeated from checkpoints until the solid's end-of-window
+//                       displacement converges; the acceleration proposes the next iterate
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <functional>
+
+#include "valvefsi/coupler/coupler_settings.hpp"
+#include "valvefsi/coupler/window_exchange.hpp"
+
+namespace valvefsi::coupler {
+
+// What one window transferred, for the interface time series.
+struct WindowRecord {
+  double time_end = 0.0;
+  double size = 0.0;
+  std::uint64_t index = 0;
+  int iterations = 1;
+  double relative_residual = 0.0;   // 0 for explicit schemes
+  bool converged = true;
+  Eigen::Vector3d force_fluid = Eigen::Vector3d::Zero();  // sum over the fluid's points (N)
+  Eigen::Vector3d force_solid = Eigen::Vector3d::Zero();  // sum over the solid's nodes (N)
+  double power_fluid = 0.0;   // sum f . v at the fluid's points (W)
+  double power_solid = 0.0;   // sum f . v at the solid's nodes (W)
+};
+
+struct SchemeSummary {
+  std::uint64_t windows = 0;
+  long total_iterations = 0;
+  std::uint64_t unconverged_windows = 0;
+  double final_time = 0.0;
+};
+
+using WindowObserver = std::function<void(const WindowRecord&)>;
+
+// Size of the window starting at `time`: the smallest of the case's window and the positive
+// proposals, cut (or stretched by a sliver) to land exactly on end_time.
+double next_window_size(double time, double end_time, double case_window, double fluid_proposal,
+                        double solid_proposal);
+
+// Runs windows from t = 0 to settings.end_time. Throws the transport's errors.
+SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSettings& settings,
+                                  const WindowObserver& observe);
+
+}  // namespace valvefsi::coupler

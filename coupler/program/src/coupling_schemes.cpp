@@ -1,0 +1,157 @@
+#include "valvefsi/coupler/coupling_schemes.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "valvefsi/coupling/acceleration.hpp"
+
+namespace valvefsi::coupler {
+
+namespace {
+
+// Leftovers shorter than this fraction of a window are absorbed into the window before them.
+constexpr double kSliver = 1e-6;
+
+double power(const Eigen::Matrix3Xd& forces, const Eigen::Matrix3Xd& velocities) {
+  return (forces.array() * velocities.array()).sum();
+}
+
+void fill_record(WindowRecord& record, const WindowSpan& window, const Eigen::Matrix3Xd& fluid_forces,
+                 const Eigen::Matrix3Xd& fluid_velocities, const Eigen::Matrix3Xd& node_forces,
+                 const Eigen::Matrix3Xd& node_velocities) {
+  record.time_end = window.time + window.size;
+  record.size = window.size;
+  record.index = window.index;
+  record.force_fluid = fluid_forces.rowwise().sum();
+  record.force_solid = node_forces.rowwise().sum();
+  record.power_fluid = power(fluid_forces, fluid_velocities);
+  record.power_solid = power(node_forces, node_velocities);
+}
+
+Eigen::VectorXd flatten(const Eigen::Matrix3Xd& m) { return Eigen::Map<const Eigen::VectorXd>(m.data(), m.size()); }
+Eigen::Matrix3Xd unflatten(const Eigen::VectorXd& v) { return Eigen::Map<const Eigen::Matrix3Xd>(v.data(), 3, v.size() / 3); }
+
+struct Proposals {
+  double fluid = 0.0;
+  double solid = 0.0;
+};
+
+WindowRecord serial_explicit_window(WindowExchange& exchange, const WindowSpan& window, SolidState& solid,
+                                    Proposals& proposals) {
+  const auto fluid_velocities = exchange.send_motion_to_fluid(window, solid.positions, solid.velocities);
+  const auto fluid = exchange.receive_fluid();
+  const Eigen::Matrix3Xd node_forces = exchange.loads_to_nodes(fluid.forces);
+  exchange.send_loads_to_solid(window, node_forces);
+  auto reply = exchange.receive_solid();
+  WindowRecord record;
+  fill_record(record, window, fluid.forces, fluid_velocities, node_forces, solid.velocities);
+  solid = std::move(reply.state);
+  proposals = {fluid.max_stable_window, reply.max_stable_window};
+  return record;
+}
+
+WindowRecord parallel_explicit_window(WindowExchange& exchange, const WindowSpan& window, SolidState& solid,
+                                      Eigen::Matrix3Xd& previous_node_forces, Proposals& proposals) {
+  const auto fluid_velocities = exchange.send_motion_to_fluid(window, solid.positions, solid.velocities);
+  exchange.send_loads_to_solid(window, previous_node_forces);
+  const auto fluid = exchange.receive_fluid();
+  auto reply = exchange.receive_solid();
+  WindowRecord record;
+  fill_record(record, window, fluid.forces, fluid_velocities, previous_node_forces, solid.velocities);
+  previous_node_forces = exchange.loads_to_nodes(fluid.forces);
+  solid = std::move(reply.state);
+  proposals = {fluid.max_stable_window, reply.max_stable_window};
+  return record;
+}
+
+WindowRecord serial_implicit_window(WindowExchange& exchange, const CouplerSettings& settings, WindowSpan window,
+                                    SolidState& solid, coupling::Acceleration& acceleration, Proposals& proposals) {
+  const Eigen::Matrix3Xd& reference = exchange.session().solid_surface.positions;
+  // The iterate is the solid's end-of-window displacement; start from constant velocity.
+  Eigen::VectorXd input = flatten(solid.positions + window.size * solid.velocities - reference);
+  acceleration.begin_window();
+  exchange.send_checkpoint_save(window.time);
+  WindowRecord record;
+  for (int k = 0;; ++k) {
+    window.iteration = static_cast<std::uint32_t>(k);
+    if (k > 0) exchange.send_checkpoint_restore(window.time);
+    const Eigen::Matrix3Xd end_positions = reference + unflatten(input);
+    const Eigen::Matrix3Xd mean_velocities = (end_positions - solid.positions) / window.size;
+    const auto fluid_velocities = exchange.send_motion_to_fluid(window, solid.positions, mean_velocities);
+    const auto fluid = exchange.receive_fluid();
+    const Eigen::Matrix3Xd node_forces = exchange.loads_to_nodes(fluid.forces);
+    exchange.send_loads_to_solid(window, node_forces);
+    auto reply = exchange.receive_solid();
+    const Eigen::VectorXd output = flatten(reply.state.positions - reference);
+    const double residual = coupling::relative_residual(input, output);
+    fill_record(record, window, fluid.forces, fluid_velocities, node_forces, mean_velocities);
+    record.iterations = k + 1;
+    record.relative_residual = residual;
+    proposals = {fluid.max_stable_window, reply.max_stable_window};
+    record.converged = residual < settings.relative_tolerance;
+    if (record.converged || k + 1 >= settings.max_iterations) {
+      acceleration.end_window();
+      exchange.send_converged(window.time + window.size, static_cast<std::uint32_t>(k + 1), residual, record.converged);
+      if (!record.converged) {
+        spdlog::warn("coupler: window {} (t = {} s) not converged after {} iterations: relative residual {:.3e} >= {:.1e}",
+                     window.index, window.time, k + 1, residual, settings.relative_tolerance);
+      }
+      solid = std::move(reply.state);
+      return record;
+    }
+    input = acceleration.next_input(input, output);
+  }
+}
+
+}  // namespace
+
+double next_window_size(double time, double end_time, double case_window, double fluid_proposal,
+                        double solid_proposal) {
+  double size = case_window;
+  if (fluid_proposal > 0.0) size = std::min(size, fluid_proposal);
+  if (solid_proposal > 0.0) size = std::min(size, solid_proposal);
+  const double remaining = end_time - time;
+  if (remaining <= size * (1.0 + kSliver)) return remaining;
+  return size;
+}
+
+SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSettings& settings,
+                                  const WindowObserver& observe) {
+  const auto& session = exchange.session();
+  SolidState solid{session.solid_initial_positions, session.solid_initial_velocities};
+  Eigen::Matrix3Xd previous_node_forces = Eigen::Matrix3Xd::Zero(3, session.solid_surface.positions.cols());
+  std::unique_ptr<coupling::Acceleration> acceleration;
+  if (settings.scheme == SchemeKind::serial_implicit) acceleration = coupling::make_acceleration(settings.acceleration);
+
+  SchemeSummary summary;
+  Proposals proposals;
+  double time = 0.0;
+  const double end_tolerance = kSliver * settings.window_size;
+  while (settings.end_time - time > end_tolerance) {
+    WindowSpan window;
+    window.time = time;
+    window.size = next_window_size(time, settings.end_time, settings.window_size, proposals.fluid, proposals.solid);
+    window.index = summary.windows;
+    WindowRecord record;
+    switch (settings.scheme) {
+      case SchemeKind::serial_explicit: record = serial_explicit_window(exchange, window, solid, proposals); break;
+      case SchemeKind::parallel_explicit:
+        record = parallel_explicit_window(exchange, window, solid, previous_node_forces, proposals);
+        break;
+      case SchemeKind::serial_implicit:
+        record = serial_implicit_window(exchange, settings, window, solid, *acceleration, proposals);
+        break;
+    }
+    observe(record);
+    ++summary.windows;
+    summary.total_iterations += record.iterations;
+    if (!record.converged) ++summary.unconverged_windows;
+    time = window.time + window.size;
+  }
+  summary.final_time = time;
+  return summary;
+}
+
+}  // namespace valvefsi::coupler

@@ -1,12 +1,16 @@
 // coupler --case FILE [--output DIR] [--endpoint E] [--heartbeat-interval S] [--peer-timeout S]
 //         [--startup-timeout S]
+//         [--describe-launch]
 // Couples the fluid and the solid of a case (its `coupling` part), see docs/coupling.md.
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <iostream>
+
 #include "valvefsi/case/case_loader.hpp"
 #include "valvefsi/coupler/coupler_run.hpp"
+#include "valvefsi/coupler/launch_plan.hpp"
 #include "valvefsi/coupling/transport_errors.hpp"
 
 int main(int argc, char** argv) {
@@ -26,6 +30,10 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--startup-timeout", startup_timeout, "seconds the participants get to connect (overrides the case)")
       ->check(CLI::PositiveNumber);
+  bool describe_launch = false;
+  app.add_flag("--describe-launch", describe_launch,
+               "print the programs, arguments, output folder and endpoint of the case as JSON and exit "
+               "(used by scripts/run_case.py)");
   CLI11_PARSE(app, argc, argv);
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ %v");
 
@@ -33,6 +41,10 @@ int main(int argc, char** argv) {
     const auto run_case = valvefsi::load_case(case_file);
     const std::filesystem::path output = output_dir.empty() ? std::filesystem::path(run_case.run().output_dir())
                                                             : std::filesystem::path(output_dir);
+    if (describe_launch) {
+      std::cout << valvefsi::coupler::launch_plan_json(case_file, run_case, output) << '\n';
+      return 0;
+    }
     std::filesystem::create_directories(output);
     auto settings = valvefsi::coupler::settings_from_case(run_case, output);
     if (!endpoint.empty()) settings.endpoint = endpoint;

@@ -10,6 +10,7 @@
 #include "valvefsi/coupler/interface_session.hpp"
 #include "valvefsi/coupler/series_writer.hpp"
 #include "valvefsi/coupler/window_exchange.hpp"
+#include "valvefsi/coupling/endpoint.hpp"
 #include "valvefsi/coupling/envelope_codec.hpp"
 #include "valvefsi/coupling/message_channel.hpp"
 
@@ -106,6 +107,11 @@ int run_coupler(const CouplerSettings& settings) {
     exit_code = coupling::kExitBadInput;
   }
   channel->close(kGoodbyeLinger);
+  // The socket file of an ipc:// endpoint is ours; leave nothing behind in the output folder.
+  if (const auto socket_file = coupling::ipc_socket_file(settings.endpoint); !socket_file.empty()) {
+    std::error_code ignored;
+    std::filesystem::remove(socket_file, ignored);
+  }
   return exit_code;
 }
 

@@ -1,0 +1,216 @@
+#!/usr/bin/python3
+"""Run one case: the coupler, the fluid (under mpirun when asked) and the solid, from one file.
+
+    /usr/bin/python3 scripts/run_case.py CASE [--output DIR] [--fluid-ranks N] [--fe-only]
+        [--fluid-exe PATH] [--solid-exe PATH] [--coupler-exe PATH] [--build-dir DIR] [--grace S]
+
+Each program is started as `<executable> <case arguments...> --case CASE --output DIR` (the
+solid also gets `--fe-only` with --fe-only), with VALVEFSI_COUPLER_ENDPOINT set so that all
+three meet at the same socket. Executables come from the case's `coupling` part, else the
+build tree's `fluid_sph`, `solid_fe`, `coupler`; --*-exe overrides both, so a solver can be
+swapped without editing the case. A bare name is looked up in the build tree, then on PATH.
+
+Each program's output goes to DIR/<name>.log and to the terminal prefixed with [coupler],
+[fluid] or [solid]. When one program fails, the others get SIGTERM (and SIGCONT, in case they
+are stopped), then SIGKILL after the grace period; the launcher exits with the failing
+program's code (128 + signal for a signal). SIGINT/SIGTERM to the launcher stop them all.
+The case is read by the coupler's own loader (`coupler --describe-launch`), so a bad case is
+reported exactly as the programs would report it.
+"""
+
+import argparse
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+DEFAULT_PROGRAMS = {"fluid": "fluid_sph", "solid": "solid_fe", "coupler": "coupler"}
+ENDPOINT_VARIABLE = "VALVEFSI_COUPLER_ENDPOINT"
+
+
+def fail(message, code=2):
+    print(f"run_case: {message}", file=sys.stderr, flush=True)
+    sys.exit(code)
+
+
+def find_executable(name, build_dir, role):
+    """A path with a '/' is used as is; a bare name is searched in the build tree, then PATH."""
+    if "/" in name:
+        path = Path(name)
+        if not (path.is_file() and os.access(path, os.X_OK)):
+            fail(f"{role} executable '{name}' does not exist or is not executable")
+        return str(path.resolve())
+    if build_dir.is_dir():
+        for candidate in sorted(build_dir.rglob(name)):
+            if candidate.is_file() and os.access(candidate, os.X_OK) and "CMakeFiles" not in candidate.parts:
+                return str(candidate)
+    found = shutil.which(name)
+    if found:
+        return found
+    fail(f"{role} executable '{name}' not found in the build tree {build_dir} nor on PATH "
+         f"(build it, or pass --{role}-exe PATH)")
+
+
+def launch_plan(coupler, case_file, output_dir=None):
+    command = [coupler, "--case", str(case_file), "--describe-launch"]
+    if output_dir is not None:
+        command += ["--output", str(output_dir)]
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        sys.stderr.write(result.stdout + result.stderr)
+        fail(f"the case {case_file} cannot be used (see above)", result.returncode)
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
+class Program:
+    """One child process (its own process group) whose output is prefixed and logged."""
+
+    def __init__(self, role, command, log_path, environment):
+        self.role = role
+        self.command = command
+        self.log = open(log_path, "w", buffering=1)
+        self.log.write("# " + " ".join(command) + "\n")
+        self.process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                        stdin=subprocess.DEVNULL, env=environment, start_new_session=True)
+        self.reader = threading.Thread(target=self._pump, daemon=True)
+        self.reader.start()
+
+    def _pump(self):
+        for raw in iter(self.process.stdout.readline, b""):
+            line = raw.decode("utf-8", "replace")
+            self.log.write(line)
+            sys.stdout.write(f"[{self.role}] {line}")
+            sys.stdout.flush()
+
+    def exit_code(self):
+        code = self.process.poll()
+        if code is None:
+            return None
+        return 128 - code if code < 0 else code
+
+    def signal_group(self, sig):
+        try:
+            os.killpg(self.process.pid, sig)
+        except ProcessLookupError:
+            pass
+
+    def close(self):
+        self.reader.join(timeout=2)
+        self.log.close()
+
+
+def stop_all(programs, grace):
+    running = [p for p in programs if p.exit_code() is None]
+    for program in running:
+        program.signal_group(signal.SIGTERM)
+        program.signal_group(signal.SIGCONT)  # a stopped process only sees SIGTERM once continued
+    deadline = time.monotonic() + grace
+    while time.monotonic() < deadline and any(p.exit_code() is None for p in running):
+        time.sleep(0.05)
+    for program in running:
+        if program.exit_code() is None:
+            print(f"run_case: {program.role} did not stop within {grace} s; killing it", file=sys.stderr, flush=True)
+            program.signal_group(signal.SIGKILL)
+    for program in running:
+        program.process.wait()
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("case", type=Path, help="case file (cases/*.textproto)")
+    parser.add_argument("--output", type=Path, help="output folder (default: the case's run.output_dir)")
+    parser.add_argument("--fluid-ranks", type=int, default=1, help="MPI ranks of the fluid (mpirun -np N when N > 1)")
+    parser.add_argument("--fe-only", action="store_true", help="run only the solid, under the case's uniform pressure")
+    parser.add_argument("--fluid-exe", help="fluid program (overrides the case)")
+    parser.add_argument("--solid-exe", help="solid program (overrides the case)")
+    parser.add_argument("--coupler-exe", help="coupler program (overrides the case)")
+    parser.add_argument("--build-dir", type=Path, default=REPO / "build", help="where bare program names are found")
+    parser.add_argument("--grace", type=float, default=5.0, help="seconds between SIGTERM and SIGKILL when stopping")
+    args = parser.parse_args()
+
+    if not args.case.is_file():
+        fail(f"case file '{args.case}' does not exist")
+    if args.fluid_ranks < 1:
+        fail(f"--fluid-ranks = {args.fluid_ranks}: allowed >= 1")
+    case_file = args.case.resolve()
+    build_dir = args.build_dir.resolve()
+    coupler = find_executable(args.coupler_exe or DEFAULT_PROGRAMS["coupler"], build_dir, "coupler")
+    # Relative output folders (the case's or --output) are relative to where the launcher runs.
+    output_dir = (args.output or Path(launch_plan(coupler, case_file)["output_dir"])).resolve()
+    plan = launch_plan(coupler, case_file, output_dir)
+    output_dir.mkdir(parents=True, exist_ok=True)
+    if not args.coupler_exe and plan["coupler"]["executable"]:
+        coupler = find_executable(plan["coupler"]["executable"], build_dir, "coupler")
+
+    environment = dict(os.environ)
+    environment[ENDPOINT_VARIABLE] = plan["endpoint"]
+    common = ["--case", str(case_file), "--output", str(output_dir)]
+    fe_only = args.fe_only or plan["fe_only"]
+
+    def command_for(role, override):
+        name = override or plan[role]["executable"] or DEFAULT_PROGRAMS[role]
+        return [find_executable(name, build_dir, role)] + plan[role]["arguments"] + common
+
+    commands = []
+    if not fe_only:
+        commands.append(("coupler", [coupler] + common))
+    solid = command_for("solid", args.solid_exe)
+    commands.append(("solid", solid + (["--fe-only"] if fe_only else [])))
+    if not fe_only:
+        fluid = command_for("fluid", args.fluid_exe)
+        if args.fluid_ranks > 1:
+            mpirun = ["mpirun", "-np", str(args.fluid_ranks)]
+            if os.geteuid() == 0:
+                mpirun.append("--allow-run-as-root")
+            if args.fluid_ranks > (os.cpu_count() or 1):
+                mpirun.append("--oversubscribe")
+            fluid = mpirun + fluid
+        commands.append(("fluid", fluid))
+
+    programs = []
+    interrupted = []
+
+    def on_signal(signum, _frame):
+        interrupted.append(signum)
+
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    print(f"run_case: {case_file.name} -> {output_dir} ({'FE-only' if fe_only else plan['endpoint']})", flush=True)
+    for role, command in commands:
+        programs.append(Program(role, command, output_dir / f"{role}.log", environment))
+
+    exit_code = 0
+    while True:
+        if interrupted:
+            print(f"run_case: {signal.Signals(interrupted[0]).name} received; stopping everything", file=sys.stderr,
+                  flush=True)
+            stop_all(programs, args.grace)
+            exit_code = 128 + interrupted[0]
+            break
+        failed = [p for p in programs if p.exit_code() not in (None, 0)]
+        if failed:
+            first = failed[0]
+            exit_code = first.exit_code()
+            others = [p.role for p in programs if p is not first and p.exit_code() is None]
+            print(f"run_case: {first.role} failed with exit code {exit_code}"
+                  + (f"; stopping {', '.join(others)}" if others else ""), file=sys.stderr, flush=True)
+            stop_all(programs, args.grace)
+            break
+        if all(p.exit_code() == 0 for p in programs):
+            break
+        time.sleep(0.05)
+    for program in programs:
+        program.close()
+    if exit_code == 0:
+        print(f"run_case: finished; logs and results in {output_dir}", flush=True)
+    sys.exit(exit_code)
+
+
+if __name__ == "__main__":
+    main()

@@ -29,10 +29,13 @@ from . import MMHG_TO_PA
 PERIOD_S = 0.8                 # 75 beats per minute
 SMOOTHING_SIGMA_S = 0.003      # Gaussian width: rounds the valve-event kinks over a few ms
 SAMPLE_INTERVAL_S = 0.001      # table spacing written to the case files
+# The smoothing moves the upward zero crossing of dp from the 0 s knot to 1.88 ms; the traces
+# are evaluated that much later so that dp crosses zero upward at t = 0 exactly.
+OPENING_SHIFT_S = 0.00188
 
-VALVE_CLOSURE_S = 0.240        # knot time of aortic-valve closure (LV = Ao); smoothing moves the crossing ~5 ms earlier
+VALVE_CLOSURE_S = 0.245        # knot time of aortic-valve closure (LV = Ao); smoothing moves the crossing ~5 ms earlier
 LV_RELAXATION_TAU_S = 0.030    # isovolumic relaxation time constant (Weiss et al. 1976; normal 30-40 ms)
-AORTIC_RUNOFF_START_S = 0.265  # dicrotic wave crest, start of the diastolic run-off
+AORTIC_RUNOFF_START_S = 0.270  # dicrotic wave crest, start of the diastolic run-off
 AORTIC_RUNOFF_START_MMHG = 106.0
 AORTIC_DIASTOLIC_MMHG = 80.0   # at the end of diastole = at aortic-valve opening (t = 0)
 
@@ -41,7 +44,7 @@ _AORTIC_EJECTION_KNOTS = [
     (0.000, 80.0), (0.020, 86.0), (0.040, 94.0), (0.060, 101.0), (0.080, 107.0),
     (0.100, 112.0), (0.120, 116.0), (0.140, 118.5), (0.160, 119.5), (0.180, 118.5),
     (0.200, 116.0), (0.220, 110.5), (VALVE_CLOSURE_S, 107.0),
-    (0.250, 103.5),                                   # incisura
+    (0.255, 103.5),                                   # incisura
     (AORTIC_RUNOFF_START_S, AORTIC_RUNOFF_START_MMHG),  # dicrotic wave
 ]
 
@@ -121,9 +124,10 @@ class SmoothPeriodicTrace:
     knot_values: np.ndarray
     period: float
     sigma: float
+    shift: float = 0.0       # the trace is evaluated at t + shift
 
     def __call__(self, t) -> np.ndarray:
-        t = np.mod(np.atleast_1d(np.asarray(t, dtype=float)), self.period)
+        t = np.mod(np.atleast_1d(np.asarray(t, dtype=float)) + self.shift, self.period)
         # Unroll one period either side: the Gaussian tail beyond that is < 1e-100.
         times = np.concatenate([self.knot_times[:-1] - self.period, self.knot_times[:-1],
                                 self.knot_times + self.period])
@@ -142,12 +146,12 @@ class SmoothPeriodicTrace:
 
 def aortic_pressure_mmHg() -> SmoothPeriodicTrace:
     t, p = aortic_knots()
-    return SmoothPeriodicTrace(t, p, PERIOD_S, SMOOTHING_SIGMA_S)
+    return SmoothPeriodicTrace(t, p, PERIOD_S, SMOOTHING_SIGMA_S, OPENING_SHIFT_S)
 
 
 def ventricular_pressure_mmHg() -> SmoothPeriodicTrace:
     t, p = ventricular_knots()
-    return SmoothPeriodicTrace(t, p, PERIOD_S, SMOOTHING_SIGMA_S)
+    return SmoothPeriodicTrace(t, p, PERIOD_S, SMOOTHING_SIGMA_S, OPENING_SHIFT_S)
 
 
 def transvalvular_pressure_mmHg(t) -> np.ndarray:

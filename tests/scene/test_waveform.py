@@ -39,7 +39,7 @@ class WaveformProperties(unittest.TestCase):
         self.assertGreater(mean, 3.0)       # reference MSPD 5.0-5.3 mmHg
         self.assertLess(mean, 7.0)
 
-    def test_difference_falls_to_zero_near_235_ms(self):
+    def test_difference_falls_to_zero_between_230_and_250_ms(self):
         after_peak = self.t > 0.1
         crossing = self.t[after_peak][np.argmax(self.dp[after_peak] <= 0.0)]
         self.assertGreaterEqual(crossing, 0.23)

@@ -19,6 +19,14 @@ import numpy as np
 DEFAULT_PIXELS_ACROSS = 1000   # raster resolution over the annulus diameter
 
 
+def hexahedron_face_triangles(hexahedra: np.ndarray) -> np.ndarray:
+    """The ventricular and aortic faces of bricks (nodes 0-3, 4-7) as triangles, for the GOA
+    and profiles of a hexahedron run."""
+    h = np.asarray(hexahedra)
+    faces = [h[:, [0, 1, 2]], h[:, [0, 2, 3]], h[:, [4, 5, 6]], h[:, [4, 6, 7]]]
+    return np.concatenate(faces)
+
+
 def free_edge_radial_position(nodes: np.ndarray, midpoint_ids) -> np.ndarray:
     """Mean distance from the valve axis of the free-edge midpoints; nodes [..., N, 3]."""
     x = np.asarray(nodes)[..., np.asarray(midpoint_ids), :]

@@ -10,11 +10,13 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 
 #include "standin_common.hpp"
+#include "valvefsi/case/case_loader.hpp"
 
 namespace {
 
@@ -85,9 +87,27 @@ int main(int argc, char** argv) {
   app.add_option("--amplitude", amplitude, "prescribed motion amplitude (m); > 0 ignores the loads");
   app.add_option("--frequency", frequency, "prescribed motion frequency (Hz)")->check(CLI::PositiveNumber);
   app.add_option("--propose-window", proposed_window, "max_stable_window to propose (s), 0 = none");
+  bool fe_only = false;
+  double fe_pressure = 100.0;
+  app.add_flag("--fe-only", fe_only, "run alone (no coupler) under a uniform --fe-pressure to the case's end time");
+  app.add_option("--fe-pressure", fe_pressure, "FE-only: uniform pressure along +z (Pa)");
   CLI11_PARSE(app, argc, argv);
 
   std::unique_ptr<valvefsi::coupling::Participant> participant;
+  if (fe_only) {
+    // The same plate without a partner: the FE-only path of a real solid, in miniature.
+    return valvefsi::standins::run_guarded("standin_solid_plate", participant, [&] {
+      const double end_time = valvefsi::load_case(common.case_file).run().end_time();
+      const auto surface = make_plate(nx, ny, length, width);
+      const double force_z = fe_pressure * surface.node_areas.sum();
+      PlateState state;
+      const int windows = static_cast<int>(std::ceil(end_time / 1e-3 - 1e-9));
+      for (int n = 0; n < windows; ++n) {
+        state = advance_spring(state, force_z, mass, stiffness, std::min(1e-3, end_time - n * 1e-3));
+      }
+      spdlog::info("standin_solid_plate (FE-only): final z = {:.9e} m, v = {:.9e} m/s", state.z, state.v);
+    });
+  }
   return valvefsi::standins::run_guarded("standin_solid_plate", participant, [&] {
     participant = std::make_unique<valvefsi::coupling::Participant>(valvefsi::standins::participant_options(
         common, valvefsi::coupling::ParticipantRole::solid, "standin_solid_plate"));

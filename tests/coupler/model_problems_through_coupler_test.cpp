@@ -1,0 +1,161 @@
+// The numerics' model problems (coupler/model_problems, theory in docs/coupling-numerics.md)
+// run through the REAL coupler as separate processes (stand-ins standin_model_solid/fluid),
+// reproducing the analytic limits:
+//   incompressible piston: constant relaxation converges only below w = 2 / (1 + m_a/m_s);
+//   acoustic piston: serial explicit stable below mu = 2, diverging above; parallel explicit
+//   failing earlier, at mu = 2 (sqrt 2 - 1); IQN-ILS converging beyond both;
+//   nonlinear fixed point: IQN-ILS finds the known root where plain iteration diverges.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <regex>
+
+#include "coupled_run.hpp"
+
+namespace valvefsi::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+double value_after(const std::string& log, const std::string& label) {
+  const std::regex pattern(label + R"( = ([-+0-9.eE]+))");
+  std::smatch match;
+  if (!std::regex_search(log, match, pattern)) throw std::runtime_error("no '" + label + "' in:\n" + log);
+  return std::stod(match[1].str());
+}
+
+std::string format(double x) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.17g", x);
+  return buffer;
+}
+
+struct Outcome {
+  std::map<std::string, int> codes;
+  std::string solid_log, coupler_log;
+  std::filesystem::path dir;
+};
+
+Outcome run(const std::string& name, double end_time, const std::string& coupling, std::vector<std::string> fluid_args,
+            std::vector<std::string> solid_args) {
+  CoupledRun run({.name = name, .end_time = end_time, .coupling = coupling, .fluid = "standin_model_fluid",
+                  .fluid_args = std::move(fluid_args), .solid = "standin_model_solid", .solid_args = std::move(solid_args)});
+  Outcome outcome;
+  outcome.codes = run.wait_all(120s);
+  outcome.solid_log = run.solid->log_text();
+  outcome.coupler_log = run.coupler->log_text();
+  outcome.dir = run.dir;
+  return outcome;
+}
+
+bool all_ok(const Outcome& o) {
+  return o.codes.size() == 3 && o.codes.at("coupler") == 0 && o.codes.at("solid") == 0 && o.codes.at("fluid") == 0;
+}
+
+// ---------------------------------------------------------------- incompressible piston
+// m_s = 4 g, m_a = rho L A = 10 g: limit 2 / 3.5. F_ext = 0.1 N, dt = 1 ms.
+constexpr double kStructureMass = 0.004, kAddedMass = 0.01, kExternalForce = 0.1;
+const double kPistonLimit = 2.0 / (1.0 + kAddedMass / kStructureMass);
+const double kMonolithicAcceleration = kExternalForce / (kStructureMass + kAddedMass);
+
+Outcome incompressible(const std::string& name, double omega, double end_time, int max_iterations) {
+  const std::string a0 = format(kMonolithicAcceleration);
+  return run(name, end_time,
+             "scheme: SERIAL_IMPLICIT acceleration: CONSTANT_RELAXATION window_size: 1e-3 relative_tolerance: 1e-10"
+             " max_iterations: " + std::to_string(max_iterations) + " relaxation_factor: " + format(omega),
+             {"--model", "incompressible", "--density", "1000", "--column-length", "0.1", "--area", "1e-4",
+              "--initial-acceleration", a0},
+             {"--model", "piston", "--mass", "0.004", "--external-force", "0.1", "--initial-acceleration", a0,
+              "--area", "1e-4", "--divergence-bound", "1e30"});
+}
+
+TEST(ModelProblemsThroughCoupler, IncompressiblePistonRelaxationConvergesJustBelowTheAddedMassLimit) {
+  const auto below = incompressible("mp-incompressible-below", 0.97 * kPistonLimit, 5e-3, 1000);
+  ASSERT_TRUE(all_ok(below)) << below.coupler_log;
+  // Converged, the pair is the monolithic piston of mass m_s + m_a: u = a t^2 / 2 exactly (trapezoidal rule).
+  const double t = 5e-3, u = 0.5 * kMonolithicAcceleration * t * t;
+  EXPECT_NEAR(value_after(below.solid_log, "final u"), u, 1e-7 * u);
+  for (double r : read_series(below.dir / "coupling_series.h5", "relative_residual")) EXPECT_LT(r, 1e-10);
+}
+
+TEST(ModelProblemsThroughCoupler, IncompressiblePistonRelaxationDivergesJustAboveTheLimit) {
+  const auto above = incompressible("mp-incompressible-above", 1.03 * kPistonLimit, 1e-3, 300);
+  EXPECT_NE(above.coupler_log.find("not converged after 300 iterations"), std::string::npos) << above.coupler_log;
+  const auto residual = read_series(above.dir / "coupling_series.h5", "relative_residual");
+  ASSERT_EQ(residual.size(), 1u);
+  EXPECT_GT(residual[0], 1.0);  // it grew, it did not merely stall
+}
+
+// ---------------------------------------------------------------- acoustic piston
+// rho 1000, c 10 m/s, 100 cells over 0.1 m, CFL 0.5 (the limits are in mu, whatever the CFL; 0.5
+// keeps c dt / dx <= 1 safe from rounding): dt = 5e-5 s; m'' = rho c dt / mu; 100 Pa drive.
+Outcome acoustic(const std::string& name, const std::string& scheme, double mu, int windows) {
+  const double mass = 1000.0 * 10.0 * 5e-5 / mu;
+  return run(name, windows * 5e-5, scheme + " window_size: 5e-5 relative_tolerance: 1e-12 max_iterations: 200 relaxation_factor: 0.1",
+             {"--model", "acoustic", "--density", "1000", "--sound-speed", "10", "--column-length", "0.1", "--cells", "100",
+              "--area", "1"},
+             {"--model", "piston", "--mass", format(mass), "--external-force", "100", "--initial-acceleration",
+              format(100.0 / mass), "--area", "1"});
+}
+constexpr double kTerminalVelocity = 100.0 / (1000.0 * 10.0);  // p / (rho c)
+constexpr double kSerialLimit = 2.0;
+const double kParallelLimit = 2.0 * (std::sqrt(2.0) - 1.0);
+
+TEST(ModelProblemsThroughCoupler, AcousticPistonSerialExplicitStableBelowMuTwoDivergesAbove) {
+  const auto stable = acoustic("mp-serial-stable", "scheme: SERIAL_EXPLICIT", 0.97 * kSerialLimit, 3000);
+  ASSERT_TRUE(all_ok(stable)) << stable.coupler_log;
+  EXPECT_NEAR(value_after(stable.solid_log, "final u = [-+0-9.eE]+ m, v"), kTerminalVelocity, 1e-6 * kTerminalVelocity);
+  const auto unstable = acoustic("mp-serial-unstable", "scheme: SERIAL_EXPLICIT", 1.03 * kSerialLimit, 3000);
+  EXPECT_NE(unstable.codes.at("solid"), 0);
+  EXPECT_NE(unstable.coupler_log.find("the coupled solution diverged"), std::string::npos) << unstable.coupler_log;
+}
+
+TEST(ModelProblemsThroughCoupler, AcousticPistonParallelExplicitFailsEarlier) {
+  const auto stable = acoustic("mp-parallel-stable", "scheme: PARALLEL_EXPLICIT", 0.97 * kParallelLimit, 4000);
+  ASSERT_TRUE(all_ok(stable)) << stable.coupler_log;
+  EXPECT_NEAR(value_after(stable.solid_log, "final u = [-+0-9.eE]+ m, v"), kTerminalVelocity, 1e-6 * kTerminalVelocity);
+  const auto unstable = acoustic("mp-parallel-unstable", "scheme: PARALLEL_EXPLICIT", 1.03 * kParallelLimit, 4000);
+  EXPECT_NE(unstable.coupler_log.find("the coupled solution diverged"), std::string::npos) << unstable.coupler_log;
+  // mu = 1.5: serial explicit is fine, parallel explicit is not.
+  EXPECT_NE(acoustic("mp-parallel-1.5", "scheme: PARALLEL_EXPLICIT", 1.5, 4000).coupler_log.find("diverged"),
+            std::string::npos);
+  EXPECT_TRUE(all_ok(acoustic("mp-serial-1.5", "scheme: SERIAL_EXPLICIT", 1.5, 4000)));
+}
+
+TEST(ModelProblemsThroughCoupler, AcousticPistonIqnIlsConvergesBeyondBothExplicitLimits) {
+  for (const double mu : {2.5, 10.0}) {
+    const auto implicit = acoustic("mp-iqn-" + std::to_string(static_cast<int>(mu)), "scheme: SERIAL_IMPLICIT acceleration: IQN_ILS", mu, 1500);
+    ASSERT_TRUE(all_ok(implicit)) << implicit.coupler_log;
+    EXPECT_NEAR(value_after(implicit.solid_log, "final u = [-+0-9.eE]+ m, v"), kTerminalVelocity, 1e-6 * kTerminalVelocity)
+        << "mu " << mu;
+    const auto iterations = read_series(implicit.dir / "coupling_series.h5", "iterations");
+    EXPECT_LE(*std::max_element(iterations.begin(), iterations.end()), 4.0) << "mu " << mu;  // as in-process
+  }
+}
+
+// ---------------------------------------------------------------- nonlinear fixed point
+TEST(ModelProblemsThroughCoupler, NonlinearFixedPointIqnIlsFindsTheRootPlainIterationDoesNot) {
+  const std::string common = "scheme: SERIAL_IMPLICIT window_size: 1 relative_tolerance: 1e-12 max_iterations: 60 ";
+  const auto iqn = run("mp-fixed-iqn", 1.0, common + "acceleration: IQN_ILS relaxation_factor: 0.1",
+                       {"--model", "fixed-point", "--area", "1"}, {"--model", "fixed-point", "--area", "1"});
+  ASSERT_TRUE(all_ok(iqn)) << iqn.coupler_log;
+  const auto iterations = read_series(iqn.dir / "coupling_series.h5", "iterations");
+  ASSERT_EQ(iterations.size(), 1u);
+  EXPECT_LE(iterations[0], 20.0);
+  const std::regex root(R"(final x = \[([-+0-9.eE]+), ([-+0-9.eE]+), ([-+0-9.eE]+)\])");
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(iqn.solid_log, match, root)) << iqn.solid_log;
+  EXPECT_NEAR(std::stod(match[1].str()), 0.4, 1e-9);
+  EXPECT_NEAR(std::stod(match[2].str()), -0.3, 1e-9);
+  EXPECT_NEAR(std::stod(match[3].str()), 0.8, 1e-9);
+
+  const auto plain = run("mp-fixed-plain", 1.0, common + "acceleration: CONSTANT_RELAXATION relaxation_factor: 1",
+                         {"--model", "fixed-point", "--area", "1"},
+                         {"--model", "fixed-point", "--area", "1", "--divergence-bound", "1e30"});
+  EXPECT_NE(plain.coupler_log.find("not converged after 60 iterations"), std::string::npos) << plain.coupler_log;
+}
+
+}  // namespace
+}  // namespace valvefsi::testing

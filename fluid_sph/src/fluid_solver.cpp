@@ -101,7 +101,7 @@ void FluidSolver<D>::step() {
   for (std::size_t k = 0; k < plates_.size(); ++k) {
     auto& plate = plates_[k];
     plate.fluid_force = body_forces_[k + 1];
-    plate.acceleration = plate.acceleration_at(time_, plate.fluid_force);
+    plate.acceleration = plate.acceleration_at(time_, plate.fluid_force, settings_.background_pressure);
     plate.velocity += 0.5 * dt * plate.acceleration;
   }
 
@@ -122,8 +122,29 @@ void FluidSolver<D>::step() {
   }
   max_speed_ = std::sqrt(max_speed2);
   max_acceleration_ = std::sqrt(max_acc2);
+  if (settings_.shifting > 0) shift_particles(dt);
   ++steps_;
   choose_time_step();
+}
+
+template <int D>
+void FluidSolver<D>::shift_particles(double dt) {
+  auto& p = particles_;
+  const auto& s = settings_;
+  const double scale = s.shifting * s.smoothing_length() * max_speed_ * dt;
+  const double cap = s.max_shift_fraction * s.particle_spacing;
+  const auto n = static_cast<std::ptrdiff_t>(p.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    if (p.kind[i] != Kind::fluid || p.kernel_sum[i] < s.free_surface_kernel_sum) continue;
+    double shift[D], length2 = 0;
+    for (int d = 0; d < D; ++d) {
+      shift[d] = -scale * p.kernel_sum_gradient[d][i];
+      length2 += shift[d] * shift[d];
+    }
+    const double factor = length2 > cap * cap ? cap / std::sqrt(length2) : 1.0;
+    for (int d = 0; d < D; ++d) p.position[d][i] += factor * shift[d];
+  }
 }
 
 template <int D>

@@ -53,6 +53,8 @@ struct ParticleView {
 
 struct Rates3 {
   float acc[3] = {0.0f, 0.0f, 0.0f};
+  float kernel_sum_gradient[3] = {0.0f, 0.0f, 0.0f};  // times 1/m
+  float kernel_sum = 0.0f;                            // times 1/m
   float continuity = 0.0f;
   float diffusion = 0.0f;
 };
@@ -69,7 +71,7 @@ struct Rates3 {
 // The artificial viscosity uses 1/rho_bar = (1/rho_a + 1/rho_b)/2 instead of
 // 2/(rho_a + rho_b): equal to second order in the (sub-percent) density variation, and it
 // keeps divisions out of the loop.
-template <int D, bool WithArtificialViscosity, bool OnlyFluidNeighbours, class Kernel>
+template <int D, bool WithArtificialViscosity, bool OnlyFluidNeighbours, bool WithKernelSum, class Kernel>
 inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, const Kernel& W, std::uint32_t a,
                         const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments, int segment_count) {
   const float excess_a = p.excess[a];
@@ -80,7 +82,7 @@ inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, con
     va[d] = p.v[d][a];
     vva[d] = p.vv[d][a];
   }
-  float ax = 0, ay = 0, az = 0, cont = 0, diff = 0;
+  float ax = 0, ay = 0, az = 0, cont = 0, diff = 0, csum = 0, cgx = 0, cgy = 0, cgz = 0;
   for (int s = 0; s < segment_count; ++s) {
     const auto& seg = segments[s];
     float xa[3] = {0, 0, 0};
@@ -98,13 +100,14 @@ inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, con
     const float* inv = p.inverse_density;
     const float* pr = p.pressure;
     const float* fluid = p.fluid;
-#pragma omp simd reduction(+ : ax, ay, az, cont, diff)
+#pragma omp simd reduction(+ : ax, ay, az, cont, diff, csum, cgx, cgy, cgz)
     for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
       const float dx = xa[0] - x0[b];
       const float dy = xa[1] - x1[b];
       const float dz = D == 3 ? xa[2] - x2[b] : 0.0f;
       const float r2 = dx * dx + dy * dy + dz * dz;
-      const float F = W.gradient_factor(std::sqrt(r2));  // zero beyond the support
+      const float r = std::sqrt(r2);
+      const float F = W.gradient_factor(r);  // zero beyond the support
       const float is_fluid = fluid[b];
       const float weight = OnlyFluidNeighbours ? F * is_fluid : F;
       const float inv_b = inv[b];
@@ -125,6 +128,12 @@ inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, con
       float g_dot_rba = -(k.gravity[0] * dx + k.gravity[1] * dy);
       if constexpr (D == 3) g_dot_rba -= k.gravity[D - 1] * dz;
       diff += is_fluid * (ex[b] - excess_a - k.hydrostatic * g_dot_rba) * (-F) * inv_b;
+      if constexpr (WithKernelSum) {
+        csum += W.value(r) * inv_b;
+        cgx += F * dx * inv_b;
+        cgy += F * dy * inv_b;
+        if constexpr (D == 3) cgz += F * dz * inv_b;
+      }
     }
   }
   Rates3 r;
@@ -133,6 +142,10 @@ inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, con
   r.acc[2] = az;
   r.continuity = cont;
   r.diffusion = diff;
+  r.kernel_sum = csum;
+  r.kernel_sum_gradient[0] = cgx;
+  r.kernel_sum_gradient[1] = cgy;
+  r.kernel_sum_gradient[2] = cgz;
   return r;
 }
 
@@ -148,11 +161,12 @@ void update_fluid_pressure(Particles<D>& p, const FluidSettings<D>& s) {
   const float* excess = p.density_excess.data();
   const Kind* kind = p.kind.data();
   float* inverse = p.inverse_density.data();
+  const float background = static_cast<float>(s.background_pressure);
 #pragma omp parallel for simd schedule(static)
   for (std::ptrdiff_t i = 0; i < n; ++i) {
     if (kind[i] == Kind::fluid) {
       inverse[i] = 1.0f / (rho0 + excess[i]);
-      pressure[i] = bulk * excess[i] * inverse[i];  // eq. 5 with s = 0, Gamma0 = 0
+      pressure[i] = bulk * excess[i] * inverse[i] + background;  // eq. 5 with s = 0, Gamma0 = 0
     }
   }
 }
@@ -199,11 +213,12 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
         for (int d = 0; d < D; ++d) pw += (s.gravity[d] - a_w[d]) * sum_rho_r[d];
         pw /= sum_w;
         p.pressure[w] = static_cast<float>(pw);
-        p.density_excess[w] = static_cast<float>(eos.density_excess(pw));
-        p.inverse_density[w] = static_cast<float>(1.0 / (s.rest_density + eos.density_excess(pw)));
+        const double excess = eos.density_excess(pw - s.background_pressure);
+        p.density_excess[w] = static_cast<float>(excess);
+        p.inverse_density[w] = static_cast<float>(1.0 / (s.rest_density + excess));
         for (int d = 0; d < D; ++d) p.viscous_velocity[d][w] = 2.0f * p.velocity[d][w] - sum_v[d] / sum_w;
       } else {
-        p.pressure[w] = 0.0f;
+        p.pressure[w] = static_cast<float>(s.background_pressure);
         p.density_excess[w] = 0.0f;
         p.inverse_density[w] = 1.0f / rho0;
         for (int d = 0; d < D; ++d) p.viscous_velocity[d][w] = p.velocity[d][w];
@@ -216,11 +231,24 @@ template <int D>
 void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s) {
   const PairConstants<D> k(s);
   const ParticleView<D> view(p);
+  const bool shifting = s.shifting > 0;
+  if (shifting) {
+    p.kernel_sum.resize(p.size());
+    for (int d = 0; d < D; ++d) p.kernel_sum_gradient[d].resize(p.size());
+  }
   with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
     for_each_particle_with_neighbours<D>(grid, [&](std::uint32_t a, const auto& segments, int count) {
       if (p.kind[a] != Kind::fluid) return;
-      const Rates3 r = k.alpha_c0 > 0 ? pair_sums<D, true, false>(view, k, W, a, segments, count)
-                                      : pair_sums<D, false, false>(view, k, W, a, segments, count);
+      Rates3 r;
+      if (shifting) {
+        r = k.alpha_c0 > 0 ? pair_sums<D, true, false, true>(view, k, W, a, segments, count)
+                           : pair_sums<D, false, false, true>(view, k, W, a, segments, count);
+        p.kernel_sum[a] = k.mass * r.kernel_sum;
+        for (int d = 0; d < D; ++d) p.kernel_sum_gradient[d][a] = k.mass * r.kernel_sum_gradient[d];
+      } else {
+        r = k.alpha_c0 > 0 ? pair_sums<D, true, false, false>(view, k, W, a, segments, count)
+                           : pair_sums<D, false, false, false>(view, k, W, a, segments, count);
+      }
       for (int d = 0; d < D; ++d) p.acceleration[d][a] = k.mass * r.acc[d] + k.gravity[d];
       p.density_rate[a] = k.mass * (r.continuity + k.diffusion * r.diffusion);
     });
@@ -237,8 +265,8 @@ std::vector<Vec<D>> compute_body_forces(const Particles<D>& p, const CellGrid<D>
   with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
     for_each_particle_with_neighbours<D>(grid, [&](std::uint32_t w, const auto& segments, int count) {
       if (p.kind[w] != Kind::wall || p.body[w] >= body_count) return;
-      const Rates3 r = k.alpha_c0 > 0 ? pair_sums<D, true, true>(view, k, W, w, segments, count)
-                                      : pair_sums<D, false, true>(view, k, W, w, segments, count);
+      const Rates3 r = k.alpha_c0 > 0 ? pair_sums<D, true, true, false>(view, k, W, w, segments, count)
+                                      : pair_sums<D, false, true, false>(view, k, W, w, segments, count);
       double* f = per_thread.data() + (static_cast<std::size_t>(omp_get_thread_num()) * body_count + p.body[w]) * D;
       for (int d = 0; d < D; ++d) f[d] += static_cast<double>(k.mass) * k.mass * r.acc[d];
     });

@@ -51,7 +51,7 @@ double pressure_at(const FluidSolver<D>& solver, const Vec<D>& x) {
       sum_w += w;
       sum_p += w * p.pressure[i];
     }
-    return sum_w > 0 ? sum_p / sum_w : 0.0;
+    return sum_w > 0 ? sum_p / sum_w - s.background_pressure : 0.0;
   });
 }
 

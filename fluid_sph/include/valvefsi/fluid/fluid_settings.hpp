@@ -18,7 +18,19 @@ struct FluidSettings {
   double sound_speed = 145.0;           // artificial c0 (m/s), the reference's value
   double density_diffusion = 0.1;       // delta of the delta-SPH term (Molteni & Colagrossi 2009)
   double artificial_viscosity = 0.0;    // alpha of Monaghan's artificial viscosity
+  // Constant pressure added to the equation of state (Pa). It does not change the pressure
+  // gradient but keeps the pair forces repulsive where the gauge pressure is negative, which
+  // suppresses the tensile instability; probes, output and plate loads report p - background.
+  double background_pressure = 0.0;
   Vec<D> gravity{};                     // body acceleration (m/s^2)
+  // Particle shifting (Skillen et al. 2013 form): each step a fluid particle moves by
+  // -A h U dt grad C, with C the kernel sum, U the largest fluid speed and A this
+  // coefficient (0: off), capped at max_shift_fraction dp. It keeps the particle
+  // distribution regular where the flow stretches it (vortices, stagnation points, edges).
+  // Skipped near a free surface (C below free_surface_kernel_sum).
+  double shifting = 0.0;
+  double max_shift_fraction = 0.05;
+  double free_surface_kernel_sum = 0.9;
   double cfl = 0.2;                     // Courant number of the acoustic and force limits
   double max_time_step = std::numeric_limits<double>::infinity();  // s
   int sort_interval = 1;                // re-sort particles by cell every this many steps

@@ -39,6 +39,7 @@ class FluidSolver {
  private:
   void evaluate_rates();
   void choose_time_step();
+  void shift_particles(double dt);
 
   FluidSettings<D> settings_;
   Particles<D> particles_;

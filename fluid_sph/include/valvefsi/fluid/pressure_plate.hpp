@@ -23,10 +23,12 @@ struct PressurePlate {
   double acceleration = 0.0;  // m/s^2
   Vec<D> fluid_force{};       // last force of the fluid on the plate (N)
 
-  double acceleration_at(double t, const Vec<D>& force) const {
+  // The fluid force includes the background pressure on the wetted face; the prescribed
+  // (gauge) pressure is raised by the same amount so the two balance.
+  double acceleration_at(double t, const Vec<D>& force, double background_pressure) const {
     double normal_force = 0.0;
     for (int d = 0; d < D; ++d) normal_force += force[d] * normal[d];
-    return (pressure(t) * area + normal_force) / mass;
+    return ((pressure(t) + background_pressure) * area + normal_force) / mass;
   }
 };
 

@@ -8,7 +8,7 @@
 namespace valvefsi::fluid {
 
 // Pressure at x, Shepard-interpolated from the fluid particles within one kernel support
-// (Pa); 0 if no fluid particle is that close.
+// (gauge: without the background pressure; Pa); 0 if no fluid particle is that close.
 template <int D>
 double pressure_at(const FluidSolver<D>& solver, const Vec<D>& x);
 

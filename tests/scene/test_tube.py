@@ -44,3 +44,28 @@ class SkirtEdge(unittest.TestCase):
         np.testing.assert_allclose(skirt_top_height(phi), base_row[:, 2], atol=1e-12)
         gap = math.pi / 3   # the commissure between leaflets 0 and 1
         self.assertEqual(float(skirt_top_height(gap)), mesh.description["param_commissure_height"])
+
+
+class FluidBlock(unittest.TestCase):
+    def test_fluid_block_parses_as_a_case(self):
+        import shutil
+        import subprocess
+        from pathlib import Path
+        from valve_scene.tube_case import fluid_block
+        if shutil.which("protoc") is None:
+            self.skipTest("protoc not installed")
+        repo = Path(__file__).resolve().parents[2]
+        text = fluid_block(0.7e-3, cycles=2) + "run { end_time: 1.6 }\n"
+        result = subprocess.run(["protoc", f"-I{repo / 'proto'}", "--encode=valvefsi.cases.Case",
+                                 str(repo / "proto" / "case.proto")], input=text.encode(), capture_output=True)
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+
+    def test_plates_have_room_to_travel(self):
+        import re
+        from valve_scene.tube_case import fluid_block
+        text = fluid_block(0.7e-3, cycles=2)
+        length = float(re.search(r"tube \{ origin: \[0, 0, (\S+)\] axis: \[0, 0, 1\] length: (\S+)", text).group(2))
+        start = float(re.search(r"tube \{ origin: \[0, 0, (\S+)\]", text).group(1))
+        area = math.pi * 0.0184 ** 2
+        # two strokes of 60 mL move the outlet plate 0.113 m beyond its start at 0.110 m
+        self.assertGreater(start + length, 0.110 + 2 * 60e-6 / area)

@@ -51,7 +51,7 @@ void FluidSolver<D>::evaluate_rates() {
     for (int d = 0; d < D; ++d) body_acceleration_[k + 1][d] = plates_[k].acceleration * plates_[k].normal[d];
   update_wall_state<D>(particles_, grid_, settings_, body_acceleration_);
   compute_fluid_rates<D>(particles_, grid_, settings_);
-  if (!plates_.empty() || body_forces_requested_) {
+  if (!plates_.empty() || body_forces_requested_ || body_forces_always_) {
     body_forces_ = compute_body_forces<D>(particles_, grid_, settings_, plates_.size() + 1);
     body_forces_requested_ = false;
   }

@@ -35,6 +35,7 @@ class FluidSolver {
   // computed it: every step when plates exist, otherwise after request_body_forces().
   const std::vector<Vec<D>>& body_forces() const { return body_forces_; }
   void request_body_forces() { body_forces_requested_ = true; }
+  void compute_body_forces_every_step(bool on) { body_forces_always_ = on; }
 
  private:
   void evaluate_rates();
@@ -48,6 +49,7 @@ class FluidSolver {
   std::vector<Vec<D>> body_forces_;
   std::vector<Vec<D>> body_acceleration_;
   bool body_forces_requested_ = false;
+  bool body_forces_always_ = false;
   double time_ = 0.0;
   double dt_ = 0.0;
   long steps_ = 0;

@@ -149,6 +149,91 @@ inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, con
   return r;
 }
 
+// The same sums as pair_sums for all particles of one cell at once: the cell's particles are
+// the SIMD lanes (padded to a multiple of kLanes with far-away dummies whose kernel weight is
+// zero) and each neighbour b is broadcast, so the sums stay in per-lane accumulators with no
+// horizontal reduction and no remainder loop. Only lanes that are fluid are written back.
+constexpr int kLanes = 8;
+constexpr int kBlock = 64;  // lanes per pass; larger cells are processed in several passes
+
+template <int D, bool WithArtificialViscosity, bool WithKernelSum, class Kernel>
+void cell_block_rates(Particles<D>& particles, const ParticleView<D>& p, const PairConstants<D>& k, const Kernel& W,
+                      std::uint32_t first, std::uint32_t last,
+                      const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments, int segment_count) {
+  alignas(64) float xa[3][kBlock], va[3][kBlock], wa[3][kBlock], pa[kBlock], inva[kBlock], exa[kBlock];
+  alignas(64) float acc[3][kBlock], cont[kBlock], diff[kBlock], csum[kBlock], cg[3][kBlock];
+  for (std::uint32_t block = first; block < last; block += kBlock) {
+    const int n = static_cast<int>(std::min<std::uint32_t>(kBlock, last - block));
+    const int padded = (n + kLanes - 1) / kLanes * kLanes;
+    for (int i = 0; i < padded; ++i) {
+      const bool real = i < n;
+      const std::uint32_t a = block + static_cast<std::uint32_t>(real ? i : 0);
+      for (int d = 0; d < 3; ++d) {
+        const bool axis = d < D;
+        xa[d][i] = axis ? (real ? p.x[d][a] : 1e15f) : 0.0f;
+        va[d][i] = axis ? p.v[d][a] : 0.0f;
+        wa[d][i] = axis ? p.vv[d][a] : 0.0f;
+        acc[d][i] = 0.0f;
+        cg[d][i] = 0.0f;
+      }
+      pa[i] = p.pressure[a];
+      inva[i] = p.inverse_density[a];
+      exa[i] = p.excess[a];
+      cont[i] = diff[i] = csum[i] = 0.0f;
+    }
+    for (int sidx = 0; sidx < segment_count; ++sidx) {
+      const auto& seg = segments[sidx];
+      float shift[3] = {0, 0, 0};
+      for (int d = 0; d < D; ++d) shift[d] = static_cast<float>(seg.shift[d]);
+      for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
+        const float xb = p.x[0][b] + shift[0], yb = p.x[1][b] + shift[1], zb = D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f;
+        const float vxb = p.v[0][b], vyb = p.v[1][b], vzb = D == 3 ? p.v[D - 1][b] : 0.0f;
+        const float wxb = p.vv[0][b], wyb = p.vv[1][b], wzb = D == 3 ? p.vv[D - 1][b] : 0.0f;
+        const float p_b = p.pressure[b], inv_b = p.inverse_density[b], ex_b = p.excess[b], is_fluid = p.fluid[b];
+#pragma omp simd aligned(xa, va, wa, pa, inva, exa, acc, cont, diff, csum, cg : 64)
+        for (int i = 0; i < padded; ++i) {
+          const float dx = xa[0][i] - xb, dy = xa[1][i] - yb, dz = D == 3 ? xa[2][i] - zb : 0.0f;
+          const float r2 = dx * dx + dy * dy + dz * dz;
+          const float r = std::sqrt(r2);
+          const float F = W.gradient_factor(r);
+          const float inv_rr = inva[i] * inv_b;
+          const float vdx = (va[0][i] - vxb) * dx + (va[1][i] - vyb) * dy + (D == 3 ? (va[2][i] - vzb) * dz : 0.0f);
+          cont[i] += vdx * F;
+          float radial = -(pa[i] + p_b) * inv_rr;
+          if constexpr (WithArtificialViscosity) {
+            const float mu_ab = k.h * std::min(vdx, 0.0f) / (r2 + k.eta2);
+            radial += k.alpha_c0 * mu_ab * 0.5f * (inva[i] + inv_b);
+          }
+          radial *= F;
+          const float viscous = k.two_mu * inv_rr * F;
+          acc[0][i] += radial * dx + viscous * (wa[0][i] - wxb);
+          acc[1][i] += radial * dy + viscous * (wa[1][i] - wyb);
+          if constexpr (D == 3) acc[2][i] += radial * dz + viscous * (wa[2][i] - wzb);
+          float g_dot_rba = -(k.gravity[0] * dx + k.gravity[1] * dy);
+          if constexpr (D == 3) g_dot_rba -= k.gravity[D - 1] * dz;
+          diff[i] += is_fluid * (ex_b - exa[i] - k.hydrostatic * g_dot_rba) * (-F) * inv_b;
+          if constexpr (WithKernelSum) {
+            csum[i] += W.value(r) * inv_b;
+            cg[0][i] += F * dx * inv_b;
+            cg[1][i] += F * dy * inv_b;
+            if constexpr (D == 3) cg[2][i] += F * dz * inv_b;
+          }
+        }
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      const std::uint32_t a = block + static_cast<std::uint32_t>(i);
+      if (particles.kind[a] != Kind::fluid) continue;
+      for (int d = 0; d < D; ++d) particles.acceleration[d][a] = k.mass * acc[d][i] + k.gravity[d];
+      particles.density_rate[a] = k.mass * (cont[i] + k.diffusion * diff[i]);
+      if constexpr (WithKernelSum) {
+        particles.kernel_sum[a] = k.mass * csum[i];
+        for (int d = 0; d < D; ++d) particles.kernel_sum_gradient[d][a] = k.mass * cg[d][i];
+      }
+    }
+  }
+}
+
 }  // namespace
 
 template <int D>
@@ -236,22 +321,29 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
     p.kernel_sum.resize(p.size());
     for (int d = 0; d < D; ++d) p.kernel_sum_gradient[d].resize(p.size());
   }
+  const auto cells = static_cast<std::ptrdiff_t>(grid.cell_count());
   with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
-    for_each_particle_with_neighbours<D>(grid, [&](std::uint32_t a, const auto& segments, int count) {
-      if (p.kind[a] != Kind::fluid) return;
-      Rates3 r;
-      if (shifting) {
-        r = k.alpha_c0 > 0 ? pair_sums<D, true, false, true>(view, k, W, a, segments, count)
-                           : pair_sums<D, false, false, true>(view, k, W, a, segments, count);
-        p.kernel_sum[a] = k.mass * r.kernel_sum;
-        for (int d = 0; d < D; ++d) p.kernel_sum_gradient[d][a] = k.mass * r.kernel_sum_gradient[d];
-      } else {
-        r = k.alpha_c0 > 0 ? pair_sums<D, true, false, false>(view, k, W, a, segments, count)
-                           : pair_sums<D, false, false, false>(view, k, W, a, segments, count);
+#pragma omp parallel
+    {
+      std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)> segments;
+#pragma omp for schedule(dynamic, 16)
+      for (std::ptrdiff_t c = 0; c < cells; ++c) {
+        const std::uint32_t first = grid.cell_start(static_cast<std::size_t>(c));
+        const std::uint32_t last = grid.cell_start(static_cast<std::size_t>(c) + 1);
+        if (first == last) continue;
+        bool any_fluid = false;
+        for (std::uint32_t a = first; a < last && !any_fluid; ++a) any_fluid = p.kind[a] == Kind::fluid;
+        if (!any_fluid) continue;
+        const int count = grid.neighbour_segments(static_cast<std::size_t>(c), segments);
+        if (k.alpha_c0 > 0) {
+          if (shifting) cell_block_rates<D, true, true>(p, view, k, W, first, last, segments, count);
+          else cell_block_rates<D, true, false>(p, view, k, W, first, last, segments, count);
+        } else {
+          if (shifting) cell_block_rates<D, false, true>(p, view, k, W, first, last, segments, count);
+          else cell_block_rates<D, false, false>(p, view, k, W, first, last, segments, count);
+        }
       }
-      for (int d = 0; d < D; ++d) p.acceleration[d][a] = k.mass * r.acc[d] + k.gravity[d];
-      p.density_rate[a] = k.mass * (r.continuity + k.diffusion * r.diffusion);
-    });
+    }
   });
 }
 

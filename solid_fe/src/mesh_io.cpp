@@ -113,6 +113,13 @@ Eigen::Matrix3Xd as_columns(const std::vector<double>& flat, hsize_t rows) {
   return m;
 }
 
+// Reads a [n][3] float64 dataset as a 3 x n matrix.
+Eigen::Matrix3Xd read_columns(const Reader& r, const std::string& path) {
+  hsize_t rows = 0;
+  const std::vector<double> flat = r.read<double>(path, 2, 3, rows);
+  return as_columns(flat, rows);
+}
+
 Plane read_plane(const Reader& r, const std::string& path) {
   const auto p = r.double_attribute(path, "point", 3);
   const auto n = r.double_attribute(path, "normal", 3);
@@ -139,7 +146,7 @@ Mesh read_mesh(const std::filesystem::path& file) {
 
   Mesh mesh;
   hsize_t rows = 0;
-  mesh.nodes = as_columns(r.read<double>("/mesh/nodes", 2, 3, rows), rows);
+  mesh.nodes = read_columns(r, "/mesh/nodes");
   if (r.exists("/mesh/triangles")) {
     const auto tri = r.read<std::int64_t>("/mesh/triangles", 2, 3, rows);
     mesh.triangles.resize(rows);
@@ -147,17 +154,16 @@ Mesh read_mesh(const std::filesystem::path& file) {
     hsize_t n = 0;
     mesh.triangle_thickness = r.read<double>("/mesh/triangle_thickness", 1, 1, n);
     mesh.triangle_circumferential =
-        as_columns(r.read<double>("/mesh/triangle_axes/circumferential", 2, 3, n), n);
-    mesh.triangle_radial = as_columns(r.read<double>("/mesh/triangle_axes/radial", 2, 3, n), n);
+        read_columns(r, "/mesh/triangle_axes/circumferential");
+    mesh.triangle_radial = read_columns(r, "/mesh/triangle_axes/radial");
   }
   if (r.exists("/mesh/hexahedra")) {
     const auto hex = r.read<std::int64_t>("/mesh/hexahedra", 2, 8, rows);
     mesh.hexahedra.resize(rows);
     std::memcpy(mesh.hexahedra.data(), hex.data(), hex.size() * sizeof(std::int64_t));
-    hsize_t n = 0;
     mesh.hexahedron_circumferential =
-        as_columns(r.read<double>("/mesh/hexahedron_axes/circumferential", 2, 3, n), n);
-    mesh.hexahedron_radial = as_columns(r.read<double>("/mesh/hexahedron_axes/radial", 2, 3, n), n);
+        read_columns(r, "/mesh/hexahedron_axes/circumferential");
+    mesh.hexahedron_radial = read_columns(r, "/mesh/hexahedron_axes/radial");
   }
   for (const auto& name : r.members("/mesh/node_sets")) {
     hsize_t n = 0;

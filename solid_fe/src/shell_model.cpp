@@ -43,6 +43,14 @@ void set_gauss_rule(int n, ShellModel& model, const std::string& source) {
 
 Eigen::Vector3d node(const Mesh& mesh, std::int64_t i) { return mesh.nodes.col(i); }
 
+// Gradient of the linear function through three points with the given values.
+Eigen::Vector2d linear_gradient(const std::array<Eigen::Vector2d, 3>& q, const std::array<double, 3>& v) {
+  Eigen::Matrix2d A;
+  A.row(0) = (q[1] - q[0]).transpose();
+  A.row(1) = (q[2] - q[0]).transpose();
+  return A.inverse() * Eigen::Vector2d(v[1] - v[0], v[2] - v[0]);
+}
+
 }  // namespace
 
 ShellModel build_shell_model(const Mesh& mesh, const ShellModelOptions& options,
@@ -116,41 +124,54 @@ ShellModel build_shell_model(const Mesh& mesh, const ShellModelOptions& options,
     for (int a = 0; a < 3; ++a) longest_edge = std::max(longest_edge, (X[(a + 1) % 3] - X[(a + 2) % 3]).norm());
     el.min_height = 2.0 * el.area / longest_edge;
 
-    const Eigen::Vector2d centroid = (p[0] + p[1] + p[2]) / 3.0;
+    // Row i of the curvature recovery: the fold angle across edge i of the exact quadratic
+    // surface w = x.kappa.x / 2 with unit kappa components, interpolated linearly on the
+    // triangles (so constant curvature is recovered exactly on any mesh).
+    const std::array<Eigen::Matrix2d, 3> unit_kappa{
+        (Eigen::Matrix2d() << 1, 0, 0, 0).finished(), (Eigen::Matrix2d() << 0, 0, 0, 1).finished(),
+        (Eigen::Matrix2d() << 0, 0.5, 0.5, 0).finished()};
     Eigen::Matrix3d rows;
     for (int i = 0; i < 3; ++i) {
       const int ia = (i + 1) % 3, ib = (i + 2) % 3;
       const std::int64_t a = tri[ia], b = tri[ib];
       const Eigen::Vector2d edge2 = (p[ib] - p[ia]).normalized();
       const Eigen::Vector2d outward{edge2.y(), -edge2.x()};  // counter-clockwise triangle: right of the edge
+      const Eigen::Vector2d midpoint = 0.5 * (p[ia] + p[ib]);
       const auto found = directed.find({b, a});
       const bool both_fixed = model.fixed[static_cast<std::size_t>(a)] && model.fixed[static_cast<std::size_t>(b)];
-      Eigen::Vector2d d;
       if (found != directed.end()) {
         const auto& ntri = mesh.triangles[static_cast<std::size_t>(found->second.first)];
         const std::int64_t opp = ntri[found->second.second];
         el.opposite[i] = static_cast<std::int32_t>(opp);
         el.edge_kind[i] = EdgeKind::interior;
-        // Unfold the neighbour into this element's plane to place its centroid.
+        // Unfold the neighbour into this element's plane.
         const Eigen::Vector3d Xa = node(mesh, a), Xb = node(mesh, b), Xo = node(mesh, opp);
         const Eigen::Vector3d e_hat = (Xb - Xa).normalized();
         const double along = (Xo - Xa).dot(e_hat);
         const double height = ((Xo - Xa) - along * e_hat).norm();
         const Eigen::Vector2d po = p[ia] + along * edge2 + height * outward;
-        d = (p[ia] + p[ib] + po) / 3.0 - centroid;
+        for (int J = 0; J < 3; ++J) {
+          const auto w = [&](const Eigen::Vector2d& q) { return 0.5 * (q - midpoint).dot(unit_kappa[J] * (q - midpoint)); };
+          const Eigen::Vector2d g_own = linear_gradient({p[ia], p[ib], p[i]}, {w(p[ia]), w(p[ib]), w(p[i])});
+          const Eigen::Vector2d g_other = linear_gradient({p[ia], p[ib], po}, {w(p[ia]), w(p[ib]), w(po)});
+          rows(i, J) = (g_other - g_own).dot(outward);
+        }
         const HingeSide sa = hinge_side(Xa, Xb, X[i], false);
         const HingeSide sb = hinge_side(Xa, Xb, Xo, true);
         el.reference_fold_angle[i] = fold_angle(sa, sb, Xa, Xb);
       } else if (both_fixed && options.clamp_fixed_edges) {
         el.edge_kind[i] = EdgeKind::clamped;
-        const Eigen::Vector2d foot = p[ia] + (centroid - p[ia]).dot(edge2) * edge2;
-        d = foot - centroid;
+        // The support keeps zero slope at the edge; w has zero slope at the edge midpoint.
+        for (int J = 0; J < 3; ++J) {
+          const auto w = [&](const Eigen::Vector2d& q) { return 0.5 * (q - midpoint).dot(unit_kappa[J] * (q - midpoint)); };
+          const Eigen::Vector2d g_own = linear_gradient({p[ia], p[ib], p[i]}, {w(p[ia]), w(p[ib]), w(p[i])});
+          rows(i, J) = -g_own.dot(outward);
+        }
       } else {
         el.edge_kind[i] = EdgeKind::free;
-        d = outward;  // row enforces zero normal curvature: t.kappa.t = 0
+        // Zero normal curvature across a free edge: t.kappa.t = 0.
+        rows.row(i) << outward.x() * outward.x(), outward.y() * outward.y(), outward.x() * outward.y();
       }
-      rows.row(i) << outward.x() * d.x(), outward.y() * d.y(),
-          0.5 * (outward.x() * d.y() + outward.y() * d.x());
     }
     const Eigen::FullPivLU<Eigen::Matrix3d> lu(rows);
     if (!lu.isInvertible()) {

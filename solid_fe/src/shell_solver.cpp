@@ -13,6 +13,9 @@
 #include "valvefsi/solid/shell_forces.hpp"
 
 namespace valvefsi::solid {
+namespace {
+constexpr std::int64_t kMinElementsForThreads = 1000;
+}  // namespace
 
 double EnergyBalance::relative_balance_error() const {
   const double scale = std::max({std::abs(kinetic), std::abs(internal_work), std::abs(external_work),
@@ -96,7 +99,8 @@ void ShellSolver::compute_internal_force(bool estimate_step) {
   const Eigen::Matrix3Xd& x = state_.position;
   std::visit(
       [&](const auto& law) {
-#pragma omp parallel
+        // Small models run serially: thread start-up would cost more than it saves.
+#pragma omp parallel if (num_elements >= kMinElementsForThreads)
         {
           Eigen::Matrix3Xd& f = thread_forces_[static_cast<std::size_t>(omp_get_thread_num())];
           f.setZero();
@@ -247,7 +251,7 @@ void ShellSolver::element_fields(Eigen::VectorXd& max_principal_stress,
   max_principal_log_strain.resize(num_elements);
   std::visit(
       [&](const auto& law) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (num_elements >= kMinElementsForThreads)
         for (Eigen::Index e = 0; e < num_elements; ++e) {
           try {
             const ElementFieldValues v =

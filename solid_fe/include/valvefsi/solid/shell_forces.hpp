@@ -23,7 +23,7 @@ namespace valvefsi::solid {
 // Wave-speed factor of the bending part in the element's highest frequency,
 // omega^2 = (2 c / L)^2 (1 + kBendingFrequencyFactor (h / L)^2); checked against the true
 // highest frequency of small meshes in tests/solid_fe/shell_stability_test.cpp.
-inline constexpr double kBendingFrequencyFactor = 5.0;
+inline constexpr double kBendingFrequencyFactor = 0.5;
 
 struct ElementState {
   Eigen::Matrix<double, 3, 2> deformation_gradient;  // F of the mid-surface (3x2)

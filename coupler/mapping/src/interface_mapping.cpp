@@ -83,6 +83,17 @@ InterfaceMapping InterfaceMapping::build(const InterfaceMesh& solid_surface, con
         bad_input("rbf_support_radius", std::to_string(options.rbf_support_radius) + " m",
                   "a finite radius > 0 m (a few node spacings) for the rbf mapping");
       }
+      if (options.rbf_nodes_per_cluster < 0) {
+        bad_input("rbf_nodes_per_cluster", std::to_string(options.rbf_nodes_per_cluster),
+                  "0 (one global system) or a cluster size > 0 (partition of unity; 30-100 is typical)");
+      }
+      if (options.rbf_nodes_per_cluster > 0) {
+        return InterfaceMapping(detail::partition_of_unity_rbf_matrix(solid_surface.positions, fluid_points,
+                                                                      options.rbf_support_radius,
+                                                                      options.rbf_linear_polynomial,
+                                                                      options.rbf_nodes_per_cluster),
+                                nullptr);
+      }
       return InterfaceMapping({}, std::make_shared<const detail::RadialBasisSystem>(
                                       solid_surface.positions, fluid_points, options.rbf_support_radius,
                                       options.rbf_linear_polynomial));

@@ -10,8 +10,10 @@
 
 namespace valvefsi::coupling::detail {
 
+// It keeps a reference to `points`, which must outlive the tree.
 class PointCloudTree {
  public:
+  explicit PointCloudTree(Eigen::Matrix3Xd&&) = delete;  // a temporary would dangle
   explicit PointCloudTree(const Eigen::Matrix3Xd& points)
       : adaptor_{points}, index_(3, adaptor_, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {}
   PointCloudTree(const PointCloudTree&) = delete;
@@ -23,6 +25,16 @@ class PointCloudTree {
     double distance_squared = 0.0;
     index_.knnSearch(query.data(), 1, &index, &distance_squared);
     return {static_cast<Eigen::Index>(index), distance_squared};
+  }
+
+  // The k nearest columns (k <= count), nearest first.
+  void nearest_k(const Eigen::Vector3d& query, int k, std::vector<std::uint32_t>& index,
+                 std::vector<double>& distance_squared) const {
+    index.resize(static_cast<std::size_t>(k));
+    distance_squared.resize(static_cast<std::size_t>(k));
+    const auto found = index_.knnSearch(query.data(), static_cast<std::size_t>(k), index.data(), distance_squared.data());
+    index.resize(found);
+    distance_squared.resize(found);
   }
 
   // All columns within `radius` (inclusive), as (index, squared distance), unsorted.

@@ -2,8 +2,6 @@
 
 #include "point_cloud_tree.hpp"
 
-#include <Eigen/Eigenvalues>
-
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -45,38 +43,15 @@ RadialBasisSystem::RadialBasisSystem(const Eigen::Matrix3Xd& nodes, const Eigen:
                              std::to_string(support_radius) + " m); check for duplicate nodes");
   }
 
-  // Linear terms only along directions in which the nodes spread: a flat (or 2D, z = 0)
-  // surface has no z-extent, and a term there would make the Schur complement singular.
-  polynomial_origin_ = nodes.rowwise().mean();
-  polynomial_axes_.resize(3, 0);
-  if (linear_polynomial) {
-    const Eigen::Matrix3Xd centred = nodes.colwise() - polynomial_origin_;
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> spread(centred * centred.transpose() /
-                                                                static_cast<double>(nodes.cols()));
-    const double largest = spread.eigenvalues().maxCoeff();
-    std::vector<Eigen::Vector3d> axes;
-    for (int k = 0; k < 3; ++k) {
-      const double variance = spread.eigenvalues()(k);
-      if (largest > 0.0 && variance > 1e-16 * largest) axes.push_back(spread.eigenvectors().col(k) / std::sqrt(variance));
-    }
-    polynomial_axes_.resize(3, static_cast<Eigen::Index>(axes.size()));
-    for (std::size_t k = 0; k < axes.size(); ++k) polynomial_axes_.col(static_cast<Eigen::Index>(k)) = axes[k];
-  }
-  node_polynomial_ = polynomial_at(nodes);
-  point_polynomial_ = polynomial_at(points);
+  polynomial_ = RbfPolynomial::fit(nodes, linear_polynomial);
+  node_polynomial_ = polynomial_.at(nodes);
+  point_polynomial_ = polynomial_.at(points);
   phi_inverse_p_ = phi_factor_.solve(node_polynomial_);
   schur_factor_.compute(node_polynomial_.transpose() * phi_inverse_p_);
   if (schur_factor_.info() != Eigen::Success) {
     throw std::runtime_error("radial-basis mapping: the polynomial part is singular for these " +
                              std::to_string(nodes.cols()) + " interface nodes");
   }
-}
-
-Eigen::MatrixXd RadialBasisSystem::polynomial_at(const Eigen::Matrix3Xd& x) const {
-  Eigen::MatrixXd p(x.cols(), 1 + polynomial_axes_.cols());
-  p.col(0).setOnes();
-  p.rightCols(polynomial_axes_.cols()) = (x.colwise() - polynomial_origin_).transpose() * polynomial_axes_;
-  return p;
 }
 
 Eigen::MatrixX3d RadialBasisSystem::consistent(const Eigen::MatrixX3d& values_at_nodes) const {

@@ -7,6 +7,8 @@
 
 #include "valvefsi/coupling/interface_mapping.hpp"
 
+#include "rbf_polynomial.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/SparseCholesky>
 
@@ -33,12 +35,9 @@ class RadialBasisSystem {
   Eigen::Index polynomial_terms() const { return node_polynomial_.cols(); }
 
  private:
-  Eigen::MatrixXd polynomial_at(const Eigen::Matrix3Xd& x) const;
-
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> phi_factor_;
   Eigen::SparseMatrix<double, Eigen::RowMajor> evaluation_;  // E_phi: phi(|x_i - x_j|), points x nodes
-  Eigen::Vector3d polynomial_origin_;
-  Eigen::Matrix3Xd polynomial_axes_;  // kept principal directions of the nodes, scaled by 1/extent
+  RbfPolynomial polynomial_;
   Eigen::MatrixXd node_polynomial_;   // P, nodes x terms
   Eigen::MatrixXd point_polynomial_;  // E_p, points x terms
   Eigen::MatrixXd phi_inverse_p_;     // Q = Phi^-1 P

@@ -13,4 +13,11 @@ Eigen::SparseMatrix<double, Eigen::RowMajor> nearest_neighbor_matrix(const Inter
 Eigen::SparseMatrix<double, Eigen::RowMajor> nearest_projection_matrix(const InterfaceMesh& surface,
                                                                         const Eigen::Matrix3Xd& points);
 
+// Partition-of-unity RBF: local Wendland C2 systems of about nodes_per_cluster nodes, blended.
+Eigen::SparseMatrix<double, Eigen::RowMajor> partition_of_unity_rbf_matrix(const Eigen::Matrix3Xd& nodes,
+                                                                            const Eigen::Matrix3Xd& points,
+                                                                            double support_radius,
+                                                                            bool linear_polynomial,
+                                                                            int nodes_per_cluster);
+
 }  // namespace valvefsi::coupling::detail

@@ -17,10 +17,11 @@ namespace {
 
 using testing::LinearField;
 
-MappingOptions options_for(MappingMethod method, double support_radius = 0.0) {
+MappingOptions options_for(MappingMethod method, double support_radius = 0.0, int nodes_per_cluster = 0) {
   MappingOptions options;
   options.method = method;
   options.rbf_support_radius = support_radius;
+  options.rbf_nodes_per_cluster = nodes_per_cluster;
   return options;
 }
 
@@ -38,6 +39,8 @@ struct Case {
   std::string name;
   MappingMethod method;
   double support_radius;
+  int nodes_per_cluster = 0;
+  MappingOptions options() const { return options_for(method, support_radius, nodes_per_cluster); }
 };
 
 class EveryMethod : public ::testing::TestWithParam<Case> {};
@@ -45,7 +48,7 @@ class EveryMethod : public ::testing::TestWithParam<Case> {};
 TEST_P(EveryMethod, RowsSumToOneAndConstantsAreExact) {
   const auto mesh = testing::curved_patch();
   const auto points = testing::points_on_cells(mesh, 400, 1);
-  const auto mapping = InterfaceMapping::build(mesh, points, options_for(GetParam().method, GetParam().support_radius));
+  const auto mapping = InterfaceMapping::build(mesh, points, GetParam().options());
   ASSERT_EQ(mapping.point_count(), 400);
   ASSERT_EQ(mapping.node_count(), mesh.positions.cols());
   const Eigen::VectorXd row_sums = mapping.matrix() * Eigen::VectorXd::Ones(mapping.node_count());
@@ -59,7 +62,7 @@ TEST_P(EveryMethod, RowsSumToOneAndConstantsAreExact) {
 TEST_P(EveryMethod, ConservativeMappingKeepsTotalForceAndPower) {
   const auto mesh = testing::curved_patch();
   const auto points = testing::points_on_cells(mesh, 500, 2);
-  const auto mapping = InterfaceMapping::build(mesh, points, options_for(GetParam().method, GetParam().support_radius));
+  const auto mapping = InterfaceMapping::build(mesh, points, GetParam().options());
   const Eigen::Matrix3Xd forces_at_points = random_field(points.cols(), 3);
   const Eigen::Matrix3Xd forces_at_nodes = mapping.map_conservative(forces_at_points);
   const Eigen::Vector3d total_points = forces_at_points.rowwise().sum();
@@ -77,7 +80,7 @@ TEST_P(EveryMethod, ConservativeMappingKeepsTotalForceAndPower) {
 TEST_P(EveryMethod, MapFunctionsApplyTheMatrixAndItsTranspose) {
   const auto mesh = testing::tilted_plate();
   const auto points = testing::points_on_cells(mesh, 150, 5);
-  const auto mapping = InterfaceMapping::build(mesh, points, options_for(GetParam().method, GetParam().support_radius));
+  const auto mapping = InterfaceMapping::build(mesh, points, GetParam().options());
   const Eigen::Matrix3Xd u = random_field(mesh.positions.cols(), 6);
   const Eigen::Matrix3Xd f = random_field(points.cols(), 7);
   const Eigen::MatrixXd h = Eigen::MatrixXd(mapping.matrix());
@@ -88,7 +91,8 @@ TEST_P(EveryMethod, MapFunctionsApplyTheMatrixAndItsTranspose) {
 INSTANTIATE_TEST_SUITE_P(Mapping, EveryMethod,
                          ::testing::Values(Case{"nearest_neighbor", MappingMethod::nearest_neighbor, 0.0},
                                            Case{"nearest_projection", MappingMethod::nearest_projection, 0.0},
-                                           Case{"rbf", MappingMethod::radial_basis, 0.004}),
+                                           Case{"rbf", MappingMethod::radial_basis, 0.004},
+                                           Case{"rbf_partition_of_unity", MappingMethod::radial_basis, 0.004, 25}),
                          [](const auto& info) { return info.param.name; });
 
 TEST(NearestProjection, ReproducesLinearFieldsOnACurvedSurface) {
@@ -151,25 +155,34 @@ TEST(NearestProjection, FindsTheClosestCellOnAnUnevenMeshAsBruteForceDoes) {
   }
 }
 
-TEST(RadialBasis, ReproducesLinearFieldsInAndOffACurvedSurface) {
+class RadialBasis : public ::testing::TestWithParam<int> {};  // nodes per cluster, 0 = global
+
+TEST_P(RadialBasis, ReproducesLinearFieldsOnAndNearACurvedSurface) {
   const auto mesh = testing::curved_patch();
   Eigen::Matrix3Xd points = testing::points_on_cells(mesh, 500, 21);
   points.rightCols(100).array() *= 1.02;  // some points 0.24 mm outside the cylinder
+  points.col(0) *= 1.5;                   // and one 6 mm off, outside every cluster
   const LinearField field = testing::some_linear_field();
-  const auto mapping = InterfaceMapping::build(mesh, points, options_for(MappingMethod::radial_basis, 0.004));
+  const auto mapping = InterfaceMapping::build(mesh, points, options_for(MappingMethod::radial_basis, 0.004, GetParam()));
   const Eigen::Matrix3Xd exact = field(points);
-  EXPECT_LT(max_abs(mapping.map_consistent(field(mesh.positions)) - exact), 1e-10 * max_abs(exact));
+  const Eigen::Matrix3Xd error = mapping.map_consistent(field(mesh.positions)) - exact;
+  EXPECT_LT(max_abs(error), 1e-10 * max_abs(exact));
 }
 
-TEST(RadialBasis, ReproducesLinearFieldsOnATiltedPlateAndA2dArc) {
+TEST_P(RadialBasis, ReproducesLinearFieldsOnATiltedPlateAndA2dArc) {
   const LinearField field = testing::some_linear_field();
   for (const auto& mesh : {testing::tilted_plate(), testing::arc_2d()}) {
     const auto points = testing::points_on_cells(mesh, 300, 22);
-    const auto mapping = InterfaceMapping::build(mesh, points, options_for(MappingMethod::radial_basis, 0.003));
+    const auto mapping =
+        InterfaceMapping::build(mesh, points, options_for(MappingMethod::radial_basis, 0.003, GetParam()));
     const Eigen::Matrix3Xd exact = field(points);
     EXPECT_LT(max_abs(mapping.map_consistent(field(mesh.positions)) - exact), 1e-10 * max_abs(exact));
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Mapping, RadialBasis, ::testing::Values(0, 12, 40), [](const auto& info) {
+  return info.param == 0 ? std::string("global") : "partition_of_unity_" + std::to_string(info.param);
+});
 
 TEST(RadialBasis, WithoutTheLinearTermsConstantsStayExactAndLinearFieldsDoNot) {
   const auto mesh = testing::curved_patch();
@@ -260,6 +273,7 @@ TEST(MappingErrors, BadInputNamesTheFieldAndWhatIsAllowed) {
   expect_error(mesh, nan_points, projection, "fluid_points");
 
   expect_error(mesh, points, options_for(MappingMethod::radial_basis, 0.0), "rbf_support_radius");
+  expect_error(mesh, points, options_for(MappingMethod::radial_basis, 0.004, -5), "rbf_nodes_per_cluster");
 
   const auto mapping = InterfaceMapping::build(mesh, points, projection);
   EXPECT_THROW((void)mapping.map_consistent(Eigen::Matrix3Xd(3, 2)), std::invalid_argument);

@@ -31,6 +31,9 @@ struct MappingOptions {
   double rbf_support_radius = 0.0;   // m; compact-support Wendland C2 RBF; required for radial_basis
   bool rbf_linear_polynomial = true; // augment with 1, x, y, z so that linear fields are exact
                                      // (false: the constant only, so rows still sum to one)
+  int rbf_nodes_per_cluster = 0;     // 0: one global RBF system (exact interpolant; build grows ~n^2);
+                                     // > 0: partition of unity of local RBF systems of about this
+                                     // many nodes (sparse H, build ~linear: for large interfaces)
 };
 
 // A sparse matrix H (n_points x n_nodes) with rows summing to one, built once from the

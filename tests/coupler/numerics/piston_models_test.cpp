@@ -226,6 +226,29 @@ TEST(AcousticPiston, ImplicitIqnIlsAndAitkenConvergeBelowAndFarAboveTheExplicitL
   }
 }
 
+TEST(AcousticPiston, IqnIlsReusingPastWindowsNeedsFewerIterations) {
+  // The window map is affine with the same Jacobian every window: kept columns make the first
+  // quasi-Newton update of a new window exact.
+  AcousticPiston piston;
+  piston.mu = 10.0;
+  AccelerationOptions reuse = acceleration(AccelerationKind::iqn_ils, 0.1);
+  reuse.reused_windows = 2;
+  const CouplingRun fresh = piston.run(CouplingScheme::implicit, 300, acceleration(AccelerationKind::iqn_ils, 0.1));
+  const CouplingRun reused = piston.run(CouplingScheme::implicit, 300, reuse);
+  ASSERT_TRUE(fresh.all_windows_converged && reused.all_windows_converged);
+  int fresh_total = 0, reused_total = 0, reused_most_after_first = 0;
+  for (std::size_t n = 0; n < fresh.windows.size(); ++n) {
+    fresh_total += fresh.windows[n].iterations;
+    reused_total += reused.windows[n].iterations;
+    if (n > 0) reused_most_after_first = std::max(reused_most_after_first, reused.windows[n].iterations);
+  }
+  std::cout << "[ acoustic ] IQN-ILS mu = 10, 300 windows: " << fresh_total << " iterations without reuse, "
+            << reused_total << " with reused_windows = 2\n";
+  EXPECT_LE(reused_most_after_first, 3);
+  EXPECT_LT(reused_total, fresh_total);
+  EXPECT_NEAR(reused.windows.back().motion(1), fresh.windows.back().motion(1), 1e-9 * piston.terminal_velocity());
+}
+
 TEST(AcousticPiston, UnrelaxedImplicitIterationConvergesOnlyBelowMuTwo) {
   const AcousticPistonLimits limits;
   AcousticPiston piston;

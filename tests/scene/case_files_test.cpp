@@ -1,0 +1,77 @@
+// The TAV case files written by scripts/valve_scene/write_cases.py load with the project's case
+// loader, and their waveform tables give the reference's pressures through the project's
+// waveform evaluator (docs/valve-scene.md).
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "valvefsi/case/case_loader.hpp"
+#include "valvefsi/case/pressure_waveform.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<fs::path> scene_cases() {
+  std::vector<fs::path> files;
+  const std::regex scene_name(R"((fe|fsi)-(ogden|mhgo)-(full|sector)-(coarse|medium|fine)\.textproto)");
+  for (const auto& entry : fs::directory_iterator(VALVEFSI_CASES_DIR)) {
+    if (std::regex_match(entry.path().filename().string(), scene_name)) files.push_back(entry.path());
+  }
+  return files;
+}
+
+double mmHg(double pascal) { return pascal / valvefsi::kPascalPerMmHg; }
+
+TEST(SceneCaseFiles, AllEighteenArePresent) {
+  // FE: 2 materials x 2 variants x 3 resolutions; FSI: 2 materials x full x 3 resolutions
+  EXPECT_EQ(scene_cases().size(), 18U);
+}
+
+TEST(SceneCaseFiles, LoadAndMatchTheirNames) {
+  const std::regex parts(R"((fe|fsi)-(ogden|mhgo)-(full|sector)-(coarse|medium|fine)\.textproto)");
+  for (const auto& file : scene_cases()) {
+    SCOPED_TRACE(file.string());
+    valvefsi::cases::Case c;
+    ASSERT_NO_THROW(c = valvefsi::load_case(file));
+    std::smatch m;
+    const std::string name = file.filename().string();
+    ASSERT_TRUE(std::regex_match(name, m, parts));
+    EXPECT_EQ(c.run().fe_only(), m[1] == "fe");
+    EXPECT_DOUBLE_EQ(c.run().end_time(), 1.6);  // two cycles
+    EXPECT_EQ(c.solid().material(), m[2] == "ogden" ? valvefsi::cases::SolidCase::OGDEN
+                                                    : valvefsi::cases::SolidCase::MHGO);
+    EXPECT_EQ(c.solid().mesh_file(), "meshes/valve-" + m[3].str() + "-" + m[4].str() + ".mesh.h5");
+    EXPECT_EQ(valvefsi::resolve_case_path(file, c.solid().mesh_file()),
+              fs::path(VALVEFSI_CASES_DIR) / "meshes" / ("valve-" + m[3].str() + "-" + m[4].str() + ".mesh.h5"));
+    EXPECT_DOUBLE_EQ(c.solid().density(), 1100.0);
+    if (m[1] == "fsi") {
+      EXPECT_DOUBLE_EQ(c.fluid().density(), 1056.0);
+      EXPECT_DOUBLE_EQ(c.fluid().sound_speed(), 145.0);
+      EXPECT_EQ(c.fluid().plates_size(), 2);
+    }
+  }
+}
+
+TEST(SceneCaseFiles, WaveformGivesTheReferencePressures) {
+  const auto files = scene_cases();
+  ASSERT_FALSE(files.empty());
+  const auto c = valvefsi::load_case(files.front());
+  ASSERT_EQ(c.waveform().time_s_size(), 800);
+  const valvefsi::PressureWaveform wf(c.waveform(), files.front().string());
+  EXPECT_DOUBLE_EQ(wf.period(), 0.8);
+  EXPECT_LT(mmHg(wf.transvalvular_pressure(-0.001)), 0.0);  // before opening (previous cycle)
+  EXPECT_GT(mmHg(wf.transvalvular_pressure(0.002)), 0.0);   // ejection has begun
+  EXPECT_NEAR(mmHg(wf.transvalvular_pressure(0.026)), 9.8, 0.2);   // forward peak
+  EXPECT_GT(mmHg(wf.transvalvular_pressure(0.230)), 0.0);
+  EXPECT_LT(mmHg(wf.transvalvular_pressure(0.245)), 0.0);          // closed by 245 ms
+  EXPECT_NEAR(mmHg(wf.transvalvular_pressure(0.361)), -97.2, 0.3);  // diastolic minimum
+  EXPECT_NEAR(mmHg(wf.transvalvular_pressure(0.75)), -69.7, 0.3);   // end diastole
+  // periodic: the second cycle repeats the first
+  EXPECT_DOUBLE_EQ(wf.transvalvular_pressure(0.3615), wf.transvalvular_pressure(1.1615));
+}
+
+}  // namespace

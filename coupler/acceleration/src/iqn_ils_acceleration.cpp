@@ -28,23 +28,27 @@ void IqnIlsAcceleration::drop_columns_beyond_capacity(Eigen::Index interface_siz
   while (columns_.size() > capacity) columns_.pop_back();
 }
 
-void IqnIlsAcceleration::filter_dependent_columns() {
+Eigen::MatrixXd IqnIlsAcceleration::stacked(bool residual_changes) const {
+  Eigen::MatrixXd m(columns_.front().residual_change.size(), static_cast<Eigen::Index>(columns_.size()));
+  for (std::size_t j = 0; j < columns_.size(); ++j) {
+    m.col(static_cast<Eigen::Index>(j)) = residual_changes ? columns_[j].residual_change : columns_[j].output_change;
+  }
+  return m;
+}
+
+Eigen::HouseholderQR<Eigen::MatrixXd> IqnIlsAcceleration::filtered_decomposition() {
   // QR filter: in V = QR (newest column first) |R_jj| is the part of column j not already
   // spanned by the newer columns; drop the column when that is below epsilon |v_j|, then redo.
   for (;;) {
-    const Eigen::Index n = columns_.front().residual_change.size();
-    Eigen::MatrixXd v(n, static_cast<Eigen::Index>(columns_.size()));
-    for (std::size_t j = 0; j < columns_.size(); ++j) v.col(static_cast<Eigen::Index>(j)) = columns_[j].residual_change;
-    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(v);
-    bool removed = false;
-    for (Eigen::Index j = 0; j < v.cols(); ++j) {
-      if (std::abs(qr.matrixQR()(j, j)) <= options_.filter_epsilon * v.col(j).norm()) {
-        columns_.erase(columns_.begin() + j);
-        removed = true;
-        break;
-      }
+    const Eigen::MatrixXd v = stacked(true);
+    Eigen::HouseholderQR<Eigen::MatrixXd> qr(v);
+    Eigen::Index dependent = -1;
+    for (Eigen::Index j = 0; j < v.cols() && dependent < 0; ++j) {
+      if (std::abs(qr.matrixQR()(j, j)) <= options_.filter_epsilon * v.col(j).norm()) dependent = j;
     }
-    if (!removed || columns_.empty()) return;
+    if (dependent < 0) return qr;
+    columns_.erase(columns_.begin() + dependent);
+    if (columns_.empty()) return qr;
   }
 }
 
@@ -60,17 +64,12 @@ Eigen::VectorXd IqnIlsAcceleration::next_input(const Eigen::VectorXd& input, con
   has_previous_ = true;
 
   drop_columns_beyond_capacity(input.size());
-  if (!columns_.empty()) filter_dependent_columns();
+  if (columns_.empty()) return input + options_.relaxation * residual;
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr = filtered_decomposition();
   if (columns_.empty()) return input + options_.relaxation * residual;
 
   const auto m = static_cast<Eigen::Index>(columns_.size());
-  Eigen::MatrixXd v(input.size(), m);
-  Eigen::MatrixXd w(input.size(), m);
-  for (Eigen::Index j = 0; j < m; ++j) {
-    v.col(j) = columns_[static_cast<std::size_t>(j)].residual_change;
-    w.col(j) = columns_[static_cast<std::size_t>(j)].output_change;
-  }
-  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(v);
+  const Eigen::MatrixXd w = stacked(false);
   const Eigen::VectorXd q_transpose_residual = (qr.householderQ().adjoint() * residual).head(m);
   const Eigen::VectorXd c =
       -qr.matrixQR().topLeftCorner(m, m).triangularView<Eigen::Upper>().solve(q_transpose_residual);

@@ -8,6 +8,8 @@
 
 #include "valvefsi/coupling/acceleration.hpp"
 
+#include <Eigen/QR>
+
 #include <deque>
 
 namespace valvefsi::coupling {
@@ -29,7 +31,8 @@ class IqnIlsAcceleration final : public Acceleration {
     int windows_ago = 0;              // 0 = built in the current window
   };
   void drop_columns_beyond_capacity(Eigen::Index interface_size);
-  void filter_dependent_columns();
+  Eigen::MatrixXd stacked(bool residual_changes) const;         // V (true) or W (false), newest first
+  Eigen::HouseholderQR<Eigen::MatrixXd> filtered_decomposition();  // drops dependent columns, returns QR of V
 
   AccelerationOptions options_;
   std::deque<Column> columns_;  // newest first

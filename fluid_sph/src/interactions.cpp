@@ -157,7 +157,7 @@ constexpr int kLanes = 8;
 constexpr int kBlock = 64;  // lanes per pass; larger cells are processed in several passes
 
 template <int D, bool WithArtificialViscosity, bool WithKernelSum, class Kernel>
-void cell_block_rates(Particles<D>& particles, const ParticleView<D>& p, const PairConstants<D>& k, const Kernel& W,
+[[gnu::noinline]] void cell_block_rates(Particles<D>& particles, const ParticleView<D>& p, const PairConstants<D>& k, const Kernel& W,
                       std::uint32_t first, std::uint32_t last,
                       const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments, int segment_count) {
   alignas(64) float xa[3][kBlock], va[3][kBlock], wa[3][kBlock], pa[kBlock], inva[kBlock], exa[kBlock];

@@ -2,6 +2,7 @@
 // SPH smoothing kernels W(r, h) with support radius 2h, in 2D and 3D.
 // Each kernel gives W and F = (dW/dr) / r, so that grad_a W_ab = F * (r_a - r_b): the
 // form the pair loops use, finite at r = 0 and free of a division by r.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -27,7 +28,7 @@ struct CubicSplineKernel {
 
   float value(float r) const {
     const float q = r * inv_h;
-    const float two_minus_q = q < 2.0f ? 2.0f - q : 0.0f;
+    const float two_minus_q = std::max(2.0f - q, 0.0f);
     const float outer = 0.25f * two_minus_q * two_minus_q * two_minus_q;
     const float inner = 1.0f - 1.5f * q * q + 0.75f * q * q * q;
     return value_scale * (q < 1.0f ? inner : outer);
@@ -35,8 +36,8 @@ struct CubicSplineKernel {
   // (dW/dr)/r; q > 0 branch divides by q only where q >= 1.
   float gradient_factor(float r) const {
     const float q = r * inv_h;
-    const float two_minus_q = q < 2.0f ? 2.0f - q : 0.0f;
-    const float outer = -0.75f * two_minus_q * two_minus_q / (q < 1.0f ? 1.0f : q);
+    const float two_minus_q = std::max(2.0f - q, 0.0f);
+    const float outer = -0.75f * two_minus_q * two_minus_q / std::max(q, 1.0f);
     const float inner = -3.0f + 2.25f * q;
     return gradient_scale * (q < 1.0f ? inner : outer);
   }
@@ -60,13 +61,13 @@ struct WendlandC2Kernel {
 
   float value(float r) const {
     const float q = r * inv_h;
-    const float s = q < 2.0f ? 1.0f - 0.5f * q : 0.0f;
+    const float s = std::max(1.0f - 0.5f * q, 0.0f);  // branch-free, so pair loops vectorise
     const float s2 = s * s;
     return value_scale * s2 * s2 * (2.0f * q + 1.0f);
   }
   float gradient_factor(float r) const {
     const float q = r * inv_h;
-    const float s = q < 2.0f ? 1.0f - 0.5f * q : 0.0f;
+    const float s = std::max(1.0f - 0.5f * q, 0.0f);
     return gradient_scale * -5.0f * s * s * s;
   }
 };

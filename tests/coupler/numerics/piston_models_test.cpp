@@ -14,6 +14,8 @@
 #include <cmath>
 #include <iostream>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 namespace valvefsi::coupling::model {
 namespace {
@@ -222,6 +224,44 @@ TEST(AcousticPiston, ImplicitIqnIlsAndAitkenConvergeBelowAndFarAboveTheExplicitL
                 << ": at most " << most << " iterations per window\n";
       EXPECT_LE(most, kind == AccelerationKind::iqn_ils ? 4 : 20) << "mu " << mu;
       EXPECT_NEAR(run.windows.back().motion(1), piston.terminal_velocity(), 1e-6 * piston.terminal_velocity());
+    }
+  }
+}
+
+TEST(AcousticPiston, TrajectoriesFollowTheAnalysedRecurrences) {
+  // The stability limits above are derived from these scalar recurrences (m'' per area, a in
+  // m/s^2): serial explicit a_{n+1} = (p_d - rho c v_n) / m'', parallel explicit uses v_{n-1},
+  // converged implicit v_{n+1}; all with v_{n+1} = v_n + dt/2 (a_n + a_{n+1}).
+  AcousticPiston piston;
+  piston.mu = 0.7;  // stable for all three
+  const double dt = piston.window(), rho_c = piston.column.density * piston.column.sound_speed;
+  const double mass = rho_c * dt / piston.mu;
+  const auto recurrence = [&](int lag, int windows) {  // lag: 0 implicit, 1 serial, 2 parallel
+    std::vector<double> v(static_cast<std::size_t>(windows) + 1, 0.0);
+    double a = piston.drive_pressure / mass;
+    for (int n = 0; n < windows; ++n) {
+      const int seen = n + 1 - lag;
+      double a_next;
+      if (lag == 0) {  // solve v_{n+1} = v_n + dt/2 (a + (p_d - rho c v_{n+1}) / m'')
+        const double v_next = (v[static_cast<std::size_t>(n)] + 0.5 * dt * (a + piston.drive_pressure / mass)) /
+                              (1.0 + 0.5 * dt * rho_c / mass);
+        a_next = (piston.drive_pressure - rho_c * v_next) / mass;
+      } else {
+        a_next = (piston.drive_pressure - rho_c * (seen >= 0 ? v[static_cast<std::size_t>(seen)] : 0.0)) / mass;
+      }
+      v[static_cast<std::size_t>(n) + 1] = v[static_cast<std::size_t>(n)] + 0.5 * dt * (a + a_next);
+      a = a_next;
+    }
+    return v;
+  };
+  const std::vector<std::pair<CouplingScheme, int>> schemes = {
+      {CouplingScheme::implicit, 0}, {CouplingScheme::serial_explicit, 1}, {CouplingScheme::parallel_explicit, 2}};
+  for (const auto& [scheme, lag] : schemes) {
+    const CouplingRun run = piston.run(scheme, 200, acceleration(AccelerationKind::iqn_ils, 0.1));
+    const std::vector<double> expected = recurrence(lag, 200);
+    ASSERT_EQ(run.windows.size(), 200u);
+    for (std::size_t n = 0; n < run.windows.size(); ++n) {
+      ASSERT_NEAR(run.windows[n].motion(1), expected[n + 1], 1e-9 * piston.terminal_velocity()) << "lag " << lag << " window " << n;
     }
   }
 }

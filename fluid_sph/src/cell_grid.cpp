@@ -108,22 +108,25 @@ void CellGrid<D>::sort(Particles<D>& p) {
     for (std::size_t i = lo; i < hi; ++i) order_[counts[cell_index_[i]]++] = static_cast<std::uint32_t>(i);
   }
 
-  p.for_each_array([&](auto& array) {
-    using T = typename std::decay_t<decltype(array)>::value_type;
-    std::vector<T> sorted(n);
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) sorted[i] = array[order_[i]];
-    array.swap(sorted);
-  });
-
+  p.for_each_array_with(sorted_, [n](auto&, auto& target) { target.resize(n); });
   for (int d = 0; d < D; ++d) p.local_position[d].resize(n);
   p.fluid_mask.resize(n);
   p.inverse_density.resize(n);
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
-    for (int d = 0; d < D; ++d) p.local_position[d][i] = static_cast<float>(p.position[d][i] - lower_[d]);
-    p.fluid_mask[i] = p.kind[i] == Kind::fluid ? 1.0f : 0.0f;
+  // One parallel region for all arrays: the gathers share no barrier until the end.
+#pragma omp parallel
+  {
+    p.for_each_array_with(sorted_, [this, n](auto& source, auto& target) {
+#pragma omp for schedule(static) nowait
+      for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) target[i] = source[order_[i]];
+    });
+#pragma omp barrier
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
+      for (int d = 0; d < D; ++d) p.local_position[d][i] = static_cast<float>(sorted_.position[d][i] - lower_[d]);
+      p.fluid_mask[i] = sorted_.kind[i] == Kind::fluid ? 1.0f : 0.0f;
+    }
   }
+  p.for_each_array_with(sorted_, [](auto& a, auto& b) { a.swap(b); });
 }
 
 template <int D>

@@ -57,6 +57,7 @@ class CellGrid {
   std::vector<std::uint32_t> cell_index_;  // per particle (scratch)
   std::vector<std::uint32_t> order_;       // gather order (scratch)
   std::vector<std::uint32_t> thread_counts_;
+  Particles<D> sorted_;                    // gather target, swapped with the particles
 };
 
 }  // namespace valvefsi::fluid

@@ -82,6 +82,24 @@ struct Particles {
     f(id);
   }
 
+  // Calls f(mine, theirs) for every per-particle array of this set and of `other`.
+  template <class F>
+  void for_each_array_with(Particles& other, F&& f) {
+    for (int d = 0; d < D; ++d) {
+      f(position[d], other.position[d]);
+      f(velocity[d], other.velocity[d]);
+      f(viscous_velocity[d], other.viscous_velocity[d]);
+      f(acceleration[d], other.acceleration[d]);
+    }
+    f(density_excess, other.density_excess);
+    f(density_rate, other.density_rate);
+    f(density_rate_previous, other.density_rate_previous);
+    f(pressure, other.pressure);
+    f(kind, other.kind);
+    f(body, other.body);
+    f(id, other.id);
+  }
+
   std::size_t count(Kind k) const {
     std::size_t n = 0;
     for (Kind x : kind) n += (x == k);

@@ -94,6 +94,7 @@ struct Reader {
       char* text = nullptr;
       H5Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
       H5Tset_size(mem.get(), H5T_VARIABLE);
+      H5Tset_cset(mem.get(), H5Tget_cset(type.get()));  // h5py writes UTF-8
       H5Aread(attr.get(), mem.get(), &text);
       std::string result = text != nullptr ? text : "";
       H5free_memory(text);

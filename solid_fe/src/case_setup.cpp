@@ -1,0 +1,158 @@
+#include "valvefsi/solid/case_setup.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "valvefsi/case/case_loader.hpp"
+
+namespace valvefsi::solid {
+
+Material material_from_case(const cases::SolidCase& solid_in, const std::string& source) {
+  // Fill the parameter blocks' documented defaults even when the case leaves them out.
+  cases::SolidCase solid = solid_in;
+  solid.mutable_mhgo();
+  solid.mutable_ogden();
+  solid.mutable_neo_hookean();
+  solid.mutable_saint_venant_kirchhoff();
+  apply_field_limits(solid, source, "solid");
+  switch (solid.material()) {
+    case cases::SolidCase::MHGO: {
+      const auto& m = solid.mhgo();
+      MhgoParameters p;
+      p.c10_Pa = m.c10_kpa() * 1e3;
+      p.c01 = m.c01();
+      p.k1_Pa = m.k1_kpa() * 1e3;
+      p.k2 = m.k2();
+      p.fibre_angle_rad = m.fibre_angle_deg() * M_PI / 180.0;
+      p.d_per_Pa = m.d_per_kpa() * 1e-3;
+      return Mhgo(p);
+    }
+    case cases::SolidCase::OGDEN: {
+      const auto& m = solid.ogden();
+      if (m.alpha1() == 0.0 || m.alpha2() == 0.0) {
+        throw CaseError(fmt::format("{}: field 'solid.ogden.alpha1/alpha2' = 0: allowed non-zero", source));
+      }
+      OgdenParameters p;
+      p.mu_Pa = {m.mu1_kpa() * 1e3, m.mu2_kpa() * 1e3};
+      p.alpha = {m.alpha1(), m.alpha2()};
+      return Ogden(p);
+    }
+    case cases::SolidCase::NEO_HOOKEAN:
+      return NeoHookean(solid.neo_hookean().shear_modulus_kpa() * 1e3);
+    case cases::SolidCase::SAINT_VENANT_KIRCHHOFF:
+      return SaintVenantKirchhoff(solid.saint_venant_kirchhoff().youngs_modulus_kpa() * 1e3,
+                                  solid.saint_venant_kirchhoff().poisson_ratio());
+    default:
+      throw CaseError(fmt::format("{}: field 'solid.material' = {}: unknown material", source,
+                                  static_cast<int>(solid.material())));
+  }
+}
+
+namespace {
+
+const std::vector<std::int64_t>& node_set(const Mesh& mesh, const std::string& name, const std::string& field,
+                                          const std::string& source, const std::string& mesh_file) {
+  const auto it = mesh.node_sets.find(name);
+  if (it == mesh.node_sets.end()) {
+    std::string names;
+    for (const auto& [n, _] : mesh.node_sets) names += (names.empty() ? "" : ", ") + n;
+    throw CaseError(fmt::format("{}: field '{}' = \"{}\": no such node set in {} (it has: {})", source, field,
+                                name, mesh_file, names.empty() ? "none" : names));
+  }
+  return it->second;
+}
+
+}  // namespace
+
+SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& case_file) {
+  const std::string source = case_file.string();
+  if (!c.has_solid()) {
+    throw CaseError(fmt::format("{}: the case has no 'solid' section; solid_fe needs one", source));
+  }
+  cases::SolidCase solid = c.solid();
+  apply_field_limits(solid, source, "solid");
+  if (solid.element_family() != cases::SolidCase::SHELL) {
+    throw CaseError(fmt::format(
+        "{}: field 'solid.element_family' = HEXAHEDRON: not implemented yet; allowed: SHELL", source));
+  }
+
+  SolidSetup setup;
+  setup.mesh_file = resolve_case_path(case_file, solid.mesh_file());
+  setup.mesh = read_mesh(setup.mesh_file);
+  const Mesh& mesh = setup.mesh;
+  const std::string mesh_name = setup.mesh_file.string();
+  if (mesh.triangles.empty()) {
+    throw CaseError(fmt::format("{}: solid.element_family = SHELL but {} has no /mesh/triangles", source, mesh_name));
+  }
+
+  ShellModelOptions options;
+  options.density = solid.density();
+  options.thickness_points = solid.thickness_points();
+  options.clamp_fixed_edges = !solid.hinged_fixed_edges();
+  std::vector<std::string> fixed_sets(solid.fixed_node_sets().begin(), solid.fixed_node_sets().end());
+  if (fixed_sets.empty()) fixed_sets.push_back("attachment");
+  std::set<std::int64_t> fixed;
+  for (const auto& name : fixed_sets) {
+    const auto& nodes = node_set(mesh, name, "solid.fixed_node_sets", source, mesh_name);
+    fixed.insert(nodes.begin(), nodes.end());
+  }
+  options.fixed_nodes.assign(fixed.begin(), fixed.end());
+
+  for (const auto& name : solid.pressure_element_sets()) {
+    const auto it = mesh.element_sets.find(name);
+    if (it == mesh.element_sets.end() || mesh.element_set_types.at(name) != "triangle") {
+      throw CaseError(fmt::format("{}: field 'solid.pressure_element_sets' = \"{}\": no triangle element set "
+                                  "of that name in {}", source, name, mesh_name));
+    }
+    setup.pressure_elements.insert(setup.pressure_elements.end(), it->second.begin(), it->second.end());
+  }
+
+  std::vector<std::string> monitor_sets(solid.monitor_node_sets().begin(), solid.monitor_node_sets().end());
+  if (monitor_sets.empty() && mesh.node_sets.count("free_edge_midpoints") != 0) {
+    monitor_sets.push_back("free_edge_midpoints");
+  }
+  for (const auto& name : monitor_sets) {
+    setup.monitors.push_back({name, node_set(mesh, name, "solid.monitor_node_sets", source, mesh_name)});
+  }
+
+  SolverOptions solver_options;
+  solver_options.time_step_safety = solid.time_step_safety();
+  solver_options.time_step_update_interval = solid.time_step_update_interval();
+  solver_options.mass_damping_per_s = solid.mass_damping_per_s();
+  solver_options.max_time_step = solid.max_time_step();
+
+  Material material = material_from_case(solid, source);
+  setup.notes.push_back(fmt::format("mesh {}: {} nodes, {} triangles; material {}; {} fixed nodes ({}), {} edges",
+                                    mesh_name, mesh.num_nodes(), mesh.num_triangles(), material_name(material),
+                                    options.fixed_nodes.size(), fmt::join(fixed_sets, ", "),
+                                    options.clamp_fixed_edges ? "clamped" : "hinged"));
+  if (solver_options.mass_damping_per_s > 0.0) {
+    setup.notes.push_back(fmt::format("mass-proportional damping ON: alpha = {} 1/s", solver_options.mass_damping_per_s));
+  }
+  setup.solver = std::make_unique<ShellSolver>(build_shell_model(mesh, options, mesh_name), std::move(material),
+                                               solver_options);
+
+  // Nodes on a mirror plane keep zero normal displacement.
+  const double size = (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
+  for (const auto& [name, plane] : mesh.symmetry_planes) {
+    std::vector<SymmetryConstraint> on_plane;
+    for (Eigen::Index n = 0; n < mesh.nodes.cols(); ++n) {
+      if (std::abs((mesh.nodes.col(n) - plane.point).dot(plane.normal)) <= 1e-6 * size) {
+        on_plane.push_back({n, plane.normal});
+      }
+    }
+    setup.notes.push_back(fmt::format("symmetry plane '{}': {} nodes", name, on_plane.size()));
+    setup.solver->add_symmetry_constraints(on_plane);
+  }
+  for (const auto& [name, plane] : mesh.contact_planes) {
+    setup.notes.push_back(fmt::format("contact plane '{}' present but contact is NOT implemented yet: "
+                                      "leaflets may cross it", name));
+  }
+  return setup;
+}
+
+}  // namespace valvefsi::solid

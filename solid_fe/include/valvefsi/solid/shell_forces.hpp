@@ -73,22 +73,26 @@ inline double max_eigenvalue(const Eigen::Matrix2d& A) {
   return mean + std::hypot(0.5 * (A(0, 0) - A(1, 1)), 0.5 * (A(0, 1) + A(1, 0)));
 }
 
-// Stable explicit step of one element from its current mid-surface stiffness.
-inline double element_stable_step(const ShellElement& el, const PlaneStressResponse& r,
-                                  const Eigen::Matrix2d& C, double density) {
-  // Reference-frame wave modulus: material part scaled by the stretch plus the stress part.
-  // The material part is bounded by the largest Gershgorin row sum of the tangent in Mandel
-  // form (an upper bound of its largest eigenvalue, cheaper than an eigen-solve).
+// Reference-frame wave modulus of one material point: the material part scaled by the stretch
+// plus the stress part. The material part is bounded by the largest Gershgorin row sum of the
+// tangent in Mandel form (an upper bound of its largest eigenvalue, cheaper than an eigen-solve).
+inline double wave_modulus(const PlaneStressResponse& r, const Eigen::Matrix2d& C) {
   const Eigen::Matrix3d& D = r.tangent;
   const double s2 = std::sqrt(2.0);
   const double material = std::max({std::abs(D(0, 0)) + std::abs(D(0, 1)) + s2 * std::abs(D(0, 2)),
                                     std::abs(D(1, 0)) + std::abs(D(1, 1)) + s2 * std::abs(D(1, 2)),
                                     s2 * std::abs(D(2, 0)) + s2 * std::abs(D(2, 1)) + 2.0 * std::abs(D(2, 2))});
-  const double modulus = max_eigenvalue(C) * material + std::max(0.0, max_eigenvalue(r.stress));
-  const double c = std::sqrt(std::max(modulus, 0.0) / density);
+  return max_eigenvalue(C) * material + std::max(0.0, max_eigenvalue(r.stress));
+}
+
+// Stable explicit step of one element from its membrane modulus (thickness average of the
+// wave modulus) and bending modulus (its z^2-weighted average), both in Pa.
+inline double element_stable_step(const ShellElement& el, double membrane_modulus, double bending_modulus,
+                                  double density) {
   const double ratio = el.thickness / el.min_height;
-  const double omega = 2.0 * c / el.min_height * std::sqrt(1.0 + kBendingFrequencyFactor * ratio * ratio);
-  return omega > 0.0 ? 2.0 / omega : std::numeric_limits<double>::infinity();
+  const double omega2 = 4.0 / (el.min_height * el.min_height) / density *
+                        (membrane_modulus + kBendingFrequencyFactor * ratio * ratio * bending_modulus);
+  return omega2 > 0.0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
 }
 
 struct ElementResult {
@@ -106,8 +110,8 @@ ElementResult add_element_internal_force(const ShellModel& model, const ShellEle
   Eigen::Matrix2d N = Eigen::Matrix2d::Zero(), M = Eigen::Matrix2d::Zero();
   const double half_thickness = 0.5 * el.thickness;
   double energy_per_area = 0.0;
-  // The stable step comes from the stiffest thickness point: with the exponential laws the
-  // outer fibres of a bent element can be far stiffer than its mid-surface.
+  // Membrane modes feel the thickness average of the stiffness, bending modes its z^2 moment.
+  double membrane_modulus = 0.0, bending_modulus = 0.0;
   for (int k = 0; k < model.thickness_points; ++k) {
     const double z = half_thickness * model.gauss_points[k];
     const double w = half_thickness * model.gauss_weights[k];
@@ -116,7 +120,14 @@ ElementResult add_element_internal_force(const ShellModel& model, const ShellEle
     N += w * r.stress;
     M += (w * z) * r.stress;
     energy_per_area += w * r.energy;
-    if (estimate_step) result.stable_step = std::min(result.stable_step, element_stable_step(el, r, C, model.density));
+    if (estimate_step) {
+      const double modulus = wave_modulus(r, C);
+      membrane_modulus += w * modulus / el.thickness;
+      bending_modulus += w * z * z * modulus * 12.0 / (el.thickness * el.thickness * el.thickness);
+    }
+  }
+  if (estimate_step) {
+    result.stable_step = element_stable_step(el, membrane_modulus, bending_modulus, model.density);
   }
   result.strain_energy = el.area * energy_per_area;
 

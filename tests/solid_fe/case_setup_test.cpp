@@ -1,0 +1,95 @@
+// Case set-up and output: a case file and a mesh file on disk give a solver with the named sets,
+// bad set names are reported with the field, and an FE-only run writes readable output.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "test_meshes.hpp"
+#include "valvefsi/case/case_loader.hpp"
+#include "valvefsi/solid/case_setup.hpp"
+#include "valvefsi/solid/solid_output.hpp"
+
+namespace valvefsi::solid {
+namespace {
+
+struct CaseFiles {
+  std::filesystem::path dir, case_file;
+};
+
+CaseFiles write_case(const std::string& name, const std::string& solid_block) {
+  CaseFiles f;
+  f.dir = std::filesystem::temp_directory_path() / ("solid_case_test_" + name);
+  std::filesystem::create_directories(f.dir);
+  Mesh mesh = testing::rectangular_plate(0.01, 0.005, 8, 4, 0.25e-3);
+  mesh.node_sets["attachment"] = mesh.node_sets.at("left");
+  mesh.node_sets["free_edge_midpoints"] = {testing::grid_node(8, 2, 8)};
+  mesh.symmetry_planes["bottom"] = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 1, 0)};
+  write_mesh(f.dir / "plate.mesh.h5", mesh);
+  f.case_file = f.dir / "plate.textproto";
+  std::ofstream(f.case_file) << "title: \"plate\"\n"
+                             << "run { end_time: 0.002 snapshot_interval: 0.001 series_interval: 0.0005 fe_only: true }\n"
+                             << "waveform { period_s: 0.8 time_s: [0, 0.4] ventricular_pressure_mmHg: [10, 10] "
+                                "aortic_pressure_mmHg: [0, 0] }\n"
+                             << "solid { mesh_file: \"plate.mesh.h5\" " << solid_block << " }\n";
+  return f;
+}
+
+TEST(CaseSetup, BuildsTheSolverFromTheCase) {
+  const CaseFiles f = write_case("ok", "material: OGDEN");
+  const cases::Case c = load_case(f.case_file);
+  const SolidSetup setup = setup_from_case(c, f.case_file);
+  EXPECT_TRUE(std::holds_alternative<Ogden>(setup.solver->material()));
+  EXPECT_NEAR(std::get<Ogden>(setup.solver->material()).parameters().mu_Pa[1], 260.56e3, 1e-6);
+  EXPECT_EQ(setup.monitors.size(), 1u);
+  EXPECT_EQ(setup.monitors[0].name, "free_edge_midpoints");
+  int fixed = 0;
+  for (auto v : setup.solver->model().fixed) fixed += v;
+  EXPECT_EQ(fixed, 5);
+}
+
+TEST(CaseSetup, UnknownNodeSetIsNamed) {
+  const CaseFiles f = write_case("bad", "fixed_node_sets: \"nope\"");
+  const cases::Case c = load_case(f.case_file);
+  try {
+    setup_from_case(c, f.case_file);
+    FAIL();
+  } catch (const CaseError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("solid.fixed_node_sets"), std::string::npos) << what;
+    EXPECT_NE(what.find("nope"), std::string::npos) << what;
+    EXPECT_NE(what.find("attachment"), std::string::npos) << "lists the sets that exist: " << what;
+  }
+}
+
+TEST(CaseSetup, FeOnlyRunWritesFieldsAndSeries) {
+  const CaseFiles f = write_case("run", "material: NEO_HOOKEAN neo_hookean { shear_modulus_kPa: 200 }");
+  const cases::Case c = load_case(f.case_file);
+  SolidSetup setup = setup_from_case(c, f.case_file);
+  ShellSolver& solver = *setup.solver;
+  const double dp = 10 * 133.322387415;
+  solver.set_pressure([dp](double) { return dp; });
+  FieldWriter fields(f.dir / "out", setup.mesh);
+  SeriesWriter series(f.dir / "out", {{"free_edge_midpoints", setup.monitors[0].nodes}});
+  for (int k = 1; k <= 4; ++k) {
+    solver.advance_window(k * 0.0005);
+    series.sample(solver, dp);
+  }
+  double peak_stress = 0, peak_strain = 0;
+  fields.write(solver, peak_stress, peak_strain);
+  series.add_snapshot_peaks(solver.state().time, peak_stress, peak_strain);
+  series.flush();
+  EXPECT_GT(peak_stress, 0.0);
+  EXPECT_GT(peak_strain, 0.0);
+  EXPECT_TRUE(std::filesystem::exists(f.dir / "out" / "solid_fields.xdmf"));
+  EXPECT_GT(std::filesystem::file_size(f.dir / "out" / "solid_series.h5"), 1000u);
+  // Symmetry plane y = 0: its nodes never move in y.
+  const Eigen::Matrix3Xd u = solver.displacement();
+  for (int i = 0; i <= 8; ++i) EXPECT_EQ(u(1, testing::grid_node(i, 0, 8)), 0.0);
+  EXPECT_GT(u(2, testing::grid_node(8, 2, 8)), 0.0) << "positive dp pushes along +normal";
+  EXPECT_LT(solver.state().energy.relative_balance_error(), 1e-3);
+  std::filesystem::remove_all(f.dir);
+}
+
+}  // namespace
+}  // namespace valvefsi::solid

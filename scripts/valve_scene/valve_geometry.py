@@ -36,7 +36,7 @@ class ValveParameters:
     """Dimensions of the generic size-23 valve (metres)."""
     annulus_radius: float = 11.5e-3        # stent inner radius R (size 23)
     commissure_height: float = 12.0e-3     # Hc: commissure tops above the leaflet base
-    tab_height: float = 3.0e-3             # h_tab: suture length along each commissure post
+    tab_height: float = 5.0e-3             # h_tab: suture length along each commissure post (see docs: sets the stable step)
     free_edge_centre_height: float = 11.0e-3  # Hm: height of the free-edge midpoints
     belly: float = 0.5                     # beta in [0, 1): depth of the leaflet belly
     coaptation_gap: float = 0.5e-3         # gap between neighbouring free edges (nearly closed)

@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .analysis import ValveEvents
 
 # Table 3 of the reference (ms); in vivo: mean and standard deviation.
 REFERENCE_KINEMATICS_MS = {

@@ -139,7 +139,6 @@ def build_valve_mesh(variant: str = "full", resolution: str = "medium", elements
     kept_normals = normals0[columns.start:].reshape(-1, 3)
     width = nv + 1
     per_leaflet = len(columns) * width
-    mid_count = per_leaflet * len(leaflets)
 
     local_i = np.repeat(np.arange(columns.start, nu + 1), width)
     local_j = np.tile(np.arange(width), len(columns))

@@ -1,5 +1,4 @@
 """The FE-only study's analysis on a synthetic run folder in solid_fe's output layout."""
-import math
 import tempfile
 import unittest
 from pathlib import Path

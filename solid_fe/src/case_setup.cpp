@@ -149,8 +149,9 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
     setup.solver->add_symmetry_constraints(on_plane);
   }
   for (const auto& [name, plane] : mesh.contact_planes) {
-    setup.notes.push_back(fmt::format("contact plane '{}' present but contact is NOT implemented yet: "
-                                      "leaflets may cross it", name));
+    setup.notes.push_back(fmt::format("contact plane '{}': penalty contact of the mid-surface offset by t/2 "
+                                      "(leaflet-leaflet contact is NOT implemented yet)", name));
+    setup.solver->add_contact_plane(plane);
   }
   return setup;
 }

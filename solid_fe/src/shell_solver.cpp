@@ -40,6 +40,11 @@ ShellSolver::ShellSolver(ShellModel model, Material material, SolverOptions opti
   state_.velocity = Eigen::Matrix3Xd::Zero(3, n);
   state_.internal_force = Eigen::Matrix3Xd::Zero(3, n);
   state_.external_force = Eigen::Matrix3Xd::Zero(3, n);
+  state_.contact_force = Eigen::Matrix3Xd::Zero(3, n);
+  half_thickness_ = Eigen::VectorXd::Zero(n);
+  for (const auto& el : model_.elements) {
+    for (const auto a : el.nodes) half_thickness_(a) = std::max(half_thickness_(a), 0.5 * el.thickness);
+  }
   acceleration_ = Eigen::Matrix3Xd::Zero(3, n);
   for (Eigen::Index i = 0; i < n; ++i) {
     if (!(model_.nodal_mass(i) > 0.0)) {
@@ -65,6 +70,35 @@ void ShellSolver::set_pressure(std::function<double(double)> pressure_Pa, std::v
 
 void ShellSolver::add_symmetry_constraints(const std::vector<SymmetryConstraint>& constraints) {
   for (const auto& c : constraints) symmetry_.push_back({c.node, c.normal.normalized()});
+}
+
+void ShellSolver::add_contact_plane(const Plane& plane) {
+  contact_planes_.push_back({plane.point, plane.normal.normalized()});
+  internal_force_current_ = false;
+}
+
+void ShellSolver::compute_contact_force() {
+  Eigen::Matrix3Xd& f = state_.contact_force;
+  f.setZero();
+  state_.nodes_in_contact = 0;
+  if (contact_planes_.empty()) return;
+  // Penalty stiffness from the highest frequency the first step resolves, k = factor m (2/dt)^2,
+  // then kept: a constant spring is conservative, and the step only shrinks as tissue stiffens.
+  if (contact_omega2_ == 0.0) {
+    const double dt_critical = state_.stable_step / options_.time_step_safety;
+    contact_omega2_ = 4.0 / (dt_critical * dt_critical);
+  }
+  const double omega2 = contact_omega2_;
+  const Eigen::Matrix3Xd& x = state_.position;
+  for (const Plane& plane : contact_planes_) {
+    for (Eigen::Index i = 0; i < x.cols(); ++i) {
+      const double gap = (x.col(i) - plane.point).dot(plane.normal) - half_thickness_(i);
+      if (gap < 0.0 && !model_.fixed[static_cast<std::size_t>(i)]) {
+        f.col(i) -= options_.contact_stiffness_factor * model_.nodal_mass(i) * omega2 * gap * plane.normal;
+        ++state_.nodes_in_contact;
+      }
+    }
+  }
 }
 
 void ShellSolver::set_velocity(const Eigen::Matrix3Xd& velocity) {
@@ -186,6 +220,7 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
   }
   if (!internal_force_current_) {
     compute_internal_force(true);
+    compute_contact_force();
     if (state_.step == 0) {
       update_kinetic_energy();
       state_.energy.initial_kinetic = state_.energy.kinetic;
@@ -199,10 +234,13 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
 
   while (state_.time < t_end) {
     compute_external_force(state_.time, nodal_forces);
-    a = (state_.external_force - state_.internal_force).array().rowwise() * inverse_mass.transpose();
+    a = (state_.external_force + state_.contact_force - state_.internal_force).array().rowwise() *
+        inverse_mass.transpose();
     apply_constraints(a);
 
-    double dt = state_.stable_step;
+    // A penalty spring of k = factor m omega^2 raises the node's frequency by sqrt(1 + factor).
+    double dt = contact_planes_.empty() ? state_.stable_step
+                                        : state_.stable_step / std::sqrt(1.0 + options_.contact_stiffness_factor);
     // Land exactly on t_end; avoid a sliver step by splitting the last two evenly.
     const double remaining = t_end - state_.time;
     if (remaining <= dt) {
@@ -212,7 +250,9 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
     }
     const double averaged_step = 0.5 * (state_.last_step + dt);
     if (alpha > 0.0) {
-      // Central difference with damping force alpha m v at the full step (implicit in v).
+      // Central difference with damping force alpha m v at the full step, v the mean of the
+      // two half-step velocities (implicit in v).
+      previous_half_velocity_ = v_half;
       v_half = ((1.0 - 0.5 * alpha * averaged_step) * v_half + averaged_step * a) /
                (1.0 + 0.5 * alpha * averaged_step);
     } else {
@@ -222,11 +262,13 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
     const Eigen::Matrix3Xd dx = dt * v_half;
     if (alpha > 0.0) {
       for (Eigen::Index i = 0; i < x.cols(); ++i) {
-        state_.energy.damping_work += alpha * model_.nodal_mass(i) * v_half.col(i).dot(dx.col(i));
+        state_.energy.damping_work +=
+            alpha * model_.nodal_mass(i) * 0.5 * (v_half.col(i) + previous_half_velocity_.col(i)).dot(dx.col(i));
       }
     }
     state_.energy.internal_work += 0.5 * (state_.internal_force.cwiseProduct(dx)).sum();
     state_.energy.external_work += 0.5 * (state_.external_force.cwiseProduct(dx)).sum();
+    state_.energy.contact_work -= 0.5 * (state_.contact_force.cwiseProduct(dx)).sum();
     x += dx;
     state_.time = (dt == remaining) ? t_end : state_.time + dt;
     ++state_.step;
@@ -234,10 +276,13 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
 
     const bool estimate = state_.step % options_.time_step_update_interval == 0;
     compute_internal_force(estimate);
+    compute_contact_force();
     compute_external_force(state_.time, nodal_forces);
     state_.energy.internal_work += 0.5 * (state_.internal_force.cwiseProduct(dx)).sum();
     state_.energy.external_work += 0.5 * (state_.external_force.cwiseProduct(dx)).sum();
-    a = (state_.external_force - state_.internal_force).array().rowwise() * inverse_mass.transpose();
+    state_.energy.contact_work -= 0.5 * (state_.contact_force.cwiseProduct(dx)).sum();
+    a = (state_.external_force + state_.contact_force - state_.internal_force).array().rowwise() *
+        inverse_mass.transpose();
     apply_constraints(a);
     state_.velocity = v_half + 0.5 * dt * a;
     update_kinetic_energy();

@@ -176,5 +176,29 @@ TEST(ShellDynamics, ClampedPlateUnderPressureMatchesKirchhoff) {
   EXPECT_LT(previous_error, 0.055);
 }
 
+TEST(ShellDynamics, ContactPlaneStopsTheMidSurfaceHalfAThicknessAway) {
+  // A pressurised membrane bulges into a rigid plane 0.5 mm above it: the mid-surface stops
+  // t/2 below the plane (penalty penetration small), and energy stays balanced.
+  const double a = 0.01, t = 0.25e-3, plane_z = 0.5e-3;
+  const Mesh mesh = rectangular_plate(a, a, 12, 12, t);
+  ShellModelOptions options;
+  options.fixed_nodes = join(join(mesh.node_sets.at("left"), mesh.node_sets.at("right")),
+                             join(mesh.node_sets.at("top"), mesh.node_sets.at("bottom")));
+  options.clamp_fixed_edges = false;
+  SolverOptions solver_options;
+  solver_options.mass_damping_per_s = 2000.0;
+  ShellSolver solver(build_shell_model(mesh, options), Material{NeoHookean{100e3}}, solver_options);
+  solver.set_pressure([](double) { return 2000.0; });
+  solver.add_contact_plane({Eigen::Vector3d(0, 0, plane_z), Eigen::Vector3d(0, 0, -1)});
+  for (int k = 1; k <= 40; ++k) solver.advance_window(k * 1e-3);
+  const double top = solver.state().position.row(2).maxCoeff();
+  EXPECT_GT(solver.state().nodes_in_contact, 10);
+  EXPECT_LT(top, plane_z - 0.5 * t + 0.1 * t) << "penetration beyond 10 % of the thickness";
+  EXPECT_GT(top, plane_z - 0.5 * t - 0.02 * t) << "the membrane reaches the contact surface";
+  EXPECT_GT(solver.state().energy.contact_work, 0.0);
+  EXPECT_LT(solver.state().energy.relative_balance_error(), 1e-2);
+}
+
+
 }  // namespace
 }  // namespace valvefsi::solid

@@ -40,6 +40,8 @@ struct ShellState {
   Eigen::Matrix3Xd velocity;           // v at `time` (for output and kinetic energy)
   Eigen::Matrix3Xd internal_force;     // at `position`
   Eigen::Matrix3Xd external_force;     // at `position`, last evaluated
+  Eigen::Matrix3Xd contact_force;      // at `position`
+  std::int64_t nodes_in_contact = 0;
   double last_step = 0;                // dt of the last step
   double stable_step = 0;              // current stable step estimate (safety applied)
   std::int64_t critical_element = -1;  // element that sets stable_step
@@ -52,6 +54,7 @@ struct SymmetryConstraint {
 };
 
 struct SolverOptions {
+  double contact_stiffness_factor = 0.1;  // penalty k = factor * m * omega_max^2 per node
   double time_step_safety = 0.8;        // fraction of the estimated critical step
   double mass_damping_per_s = 0.0;      // alpha of the damping force alpha m v (off when 0)
   int time_step_update_interval = 1;    // re-estimate the stable step every this many steps
@@ -66,6 +69,9 @@ class ShellSolver {
   // nodal force = dp * (current area vector) / 3, i.e. along +normal for dp > 0.
   void set_pressure(std::function<double(double)> pressure_Pa, std::vector<std::int64_t> elements = {});
   void add_symmetry_constraints(const std::vector<SymmetryConstraint>& constraints);
+  // Rigid plane the leaflet mid-surface may approach to half its thickness but not cross; the
+  // plane's normal points to the side where the leaflet lives. Penalty on nodes.
+  void add_contact_plane(const Plane& plane);
   void set_velocity(const Eigen::Matrix3Xd& velocity);  // initial condition (before the first step)
 
   // Advances to exactly t_end under `nodal_forces` (3 x nodes, N; constant over the window)
@@ -85,6 +91,7 @@ class ShellSolver {
  private:
   void compute_internal_force(bool estimate_step);
   void compute_external_force(double t, const Eigen::Matrix3Xd* nodal_forces);
+  void compute_contact_force();
   void apply_constraints(Eigen::Matrix3Xd& field) const;
   void update_kinetic_energy();
 
@@ -94,8 +101,12 @@ class ShellSolver {
   std::function<double(double)> pressure_;
   std::vector<std::int64_t> pressure_elements_;
   std::vector<SymmetryConstraint> symmetry_;
+  std::vector<Plane> contact_planes_;
+  double contact_omega2_ = 0.0;  // frequency^2 fixing the penalty stiffness, set at the first step
+  Eigen::VectorXd half_thickness_;  // per node: half the largest adjacent element thickness
   std::vector<Eigen::Matrix3Xd> thread_forces_;  // per-thread accumulation, allocated once
   Eigen::Matrix3Xd acceleration_;
+  Eigen::Matrix3Xd previous_half_velocity_;  // for the damping work
   bool internal_force_current_ = false;
   ShellState state_;
 };

@@ -168,8 +168,10 @@ def _crossings(t: np.ndarray, r: np.ndarray, level: float, upward: bool) -> np.n
 
 def valve_events(t, radial_position, low: float = 0.1, high: float = 0.9) -> ValveEvents:
     """RVOT, RVCT, ET over one cycle of the free-edge radial position r(t).
-    With r_min, r_max its extremes over the samples given, levels L = r_min + low (r_max - r_min)
-    and H = r_min + high (r_max - r_min): opening runs from the first upward crossing of L to
+    With r_closed = min r and r_open = the median of the samples above r_closed + half the
+    range (the open plateau, so that an opening overshoot or flutter does not move the
+    levels), L = r_closed + low (r_open - r_closed) and H = r_closed + high (r_open - r_closed):
+    opening runs from the first upward crossing of L to
     the next upward crossing of H; closing from the last downward crossing of H (before the
     final closure) to the last downward crossing of L; ejection from opening start to closing
     end. Crossing times are interpolated linearly between samples."""
@@ -180,7 +182,8 @@ def valve_events(t, radial_position, low: float = 0.1, high: float = 0.9) -> Val
     r_min, r_max = r.min(), r.max()
     if not r_max > r_min:
         raise ValueError("valve_events: the radial position never changes; the valve did not open")
-    lo, hi = r_min + low * (r_max - r_min), r_min + high * (r_max - r_min)
+    r_open = float(np.median(r[r > r_min + 0.5 * (r_max - r_min)]))
+    lo, hi = r_min + low * (r_open - r_min), r_min + high * (r_open - r_min)
     up_lo = _crossings(t, r, lo, True)
     if len(up_lo) == 0:
         raise ValueError(f"valve_events: r(t) never rises through {low:.0%} of its range (starts open?)")

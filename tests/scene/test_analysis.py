@@ -116,14 +116,23 @@ class ValveEvents(unittest.TestCase):
         r_clean = self.trapezoid(t)
         # same levels: rescale the clean curve's extremes to the fluttering one's
         events = valve_events(t, r)
-        lo = r.min() + 0.1 * (r.max() - r.min())
-        hi = r.min() + 0.9 * (r.max() - r.min())
+        r_open = np.median(r[r > r.min() + 0.5 * (r.max() - r.min())])   # the open plateau
+        self.assertAlmostEqual(r_open, 10e-3, delta=0.1e-3)
+        lo = r.min() + 0.1 * (r_open - r.min())
+        hi = r.min() + 0.9 * (r_open - r.min())
         expected_open_start = 0.010 + (lo - 0.3e-3) / (9.7e-3) * 0.020
         expected_open_end = 0.010 + (hi - 0.3e-3) / (9.7e-3) * 0.020
         self.assertAlmostEqual(events.opening_start, expected_open_start, delta=2e-5)
         self.assertAlmostEqual(events.opening_end, expected_open_end, delta=2e-5)
         self.assertGreater(events.rvct, 0.0)
         self.assertLess(abs(events.et - valve_events(t, r_clean).et), 1e-3)
+
+    def test_an_opening_overshoot_does_not_move_the_levels(self):
+        t = np.linspace(0.0, 0.8, 8001)
+        r = self.trapezoid(t) + 3e-3 * np.exp(-((t - 0.050) / 0.003) ** 2)   # 3 mm overshoot at 50 ms
+        events = valve_events(t, r)
+        self.assertAlmostEqual(events.rvct, 0.8 * 0.030, delta=1e-6)
+        self.assertAlmostEqual(events.rvot, 0.8 * 0.020, delta=1e-6)
 
     def test_a_valve_that_never_opens_is_reported(self):
         t = np.linspace(0, 0.8, 81)

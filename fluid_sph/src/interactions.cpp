@@ -296,7 +296,9 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
       if (sum_w > 0.0f) {
         double pw = sum_p;
         for (int d = 0; d < D; ++d) pw += (s.gravity[d] - a_w[d]) * sum_rho_r[d];
-        pw /= sum_w;
+        // A wall pushes but never pulls: absolute pressure (with the background) below zero
+        // would suck fluid into the wall where a free surface runs along it.
+        pw = std::max(pw / sum_w, 0.0);
         p.pressure[w] = static_cast<float>(pw);
         const double excess = eos.density_excess(pw - s.background_pressure);
         p.density_excess[w] = static_cast<float>(excess);

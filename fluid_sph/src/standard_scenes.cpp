@@ -19,7 +19,7 @@ DamBreak2D dam_break_2d(double dp, double width, double height, double tank_leng
   s.cfl = 0.2;
   const double margin = 4.0 * s.support_radius();
   s.domain_lower = {-margin, -margin};
-  s.domain_upper = {tank_length + margin, 1.5 * height + margin};
+  s.domain_upper = {tank_length + margin, 3.0 * height + margin};  // room for the run-up jet on the far wall
   db.scene.walls.push_back(container_box<2>({0.0, 0.0}, {tank_length, 1e9}));
   db.scene.fluid.push_back({{0.0, 0.0}, {width, height}, {}, {}});
   return db;

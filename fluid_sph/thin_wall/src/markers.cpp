@@ -25,8 +25,8 @@ MarkerSet::MarkerSet(const Polyline& wall, double spacing) {
   }
 }
 
-double MarkerSet::arc_length(const Polyline& wall, std::size_t segment, double t) const {
-  return segment_start_[segment] + t * wall.segment_length(segment);
+double MarkerSet::arc_length(std::size_t segment, double t) const {
+  return segment_start_[segment] + t * (segment_start_[segment + 1] - segment_start_[segment]);
 }
 
 MarkerWeights MarkerSet::weights_at(double s) const {

@@ -51,8 +51,9 @@ class MarkerSet {
   const std::vector<Marker>& markers() const { return markers_; }
   double total_length() const { return segment_start_.back(); }
 
-  // Arc length of the wall point (segment, t).
-  double arc_length(const Polyline& wall, std::size_t segment, double t) const;
+  // Arc length of the material wall point (segment, t), measured in the configuration the
+  // markers were sampled in, so that markers and queries agree while the wall deforms.
+  double arc_length(std::size_t segment, double t) const;
   MarkerWeights weights_at(double arc_length) const;
   // Force summed over all markers.
   Vec2 total_force() const;

@@ -1,0 +1,26 @@
+#pragma once
+// The 2D proof scenes of the thin wall (docs/thin-leaflet.md), shared by tests and the
+// experiment driver.
+#include "valvefsi/fluid/thin_wall/thin_wall_flow_2d.hpp"
+
+namespace valvefsi::fluid::thin_wall {
+
+// A 1 m wide tank of water split at x = 0.5 m by a vertical thin wall reaching 1.2 m, water
+// level left_level on the left and right_level on the right, both hydrostatic at rest.
+// gap = 0: the wall is buried 3 dp into the floor (attachment line); gap > 0: its lower free
+// end stands `gap` above the floor. The wall's nodes run upwards, so side +1 is the left.
+ThinWallCase2D two_level_tank(double dp, double left_level, double right_level, double gap);
+
+// A closed box [-L/2, L/2] x [-H/2, H/2] full of water (no gravity) with a plate of width b
+// along y at x = X(t) = -A cos(omega t), oscillating normal to itself (from rest).
+struct OscillatingPlate {
+  double plate_width = 0.1;      // b (m)
+  double amplitude = 0.002;      // A (m)
+  double period = 0.5;           // 2 pi / omega (s)
+  double box_length = 0.4;       // L, along the motion (m)
+  double box_height = 0.4;       // H, along the plate (m)
+  double viscosity = 1e-3;       // mu (Pa s)
+};
+ThinWallCase2D oscillating_plate_box(double dp, const OscillatingPlate& plate);
+
+}  // namespace valvefsi::fluid::thin_wall

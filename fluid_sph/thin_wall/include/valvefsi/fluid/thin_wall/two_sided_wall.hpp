@@ -1,0 +1,102 @@
+#pragma once
+// The two-sided thin wall inside the SPH fluid (2D; docs/thin-leaflet.md, DESIGN.md section 2):
+//   classify          - per particle: closest wall point, side, near-wall flag, candidate
+//                       segments; leak check against the side remembered from the last step
+//   blocked           - a pair whose connecting segment crosses the wall does not interact
+//   update_marker_states - per marker and side: Adami extrapolation of pressure (with the
+//                       wall's acceleration) and velocity from that side's fluid only
+//   add_wall_rates    - closest-point virtual layers: for fluid particle a, a lattice behind
+//                       the closest wall point, counted where the segment from a crosses the
+//                       wall, carrying that side's state; adds pressure, viscous, continuity
+//                       and kernel-sum terms to a and the opposite force to the markers
+//   correct_crossings - after the drift: a particle whose path crossed the moving wall is put
+//                       back on its side with its relative normal velocity reflected
+//   accept_shift      - particle shifting never crosses or touches the wall
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "valvefsi/fluid/cell_grid.hpp"
+#include "valvefsi/fluid/fluid_settings.hpp"
+#include "valvefsi/fluid/particles.hpp"
+#include "valvefsi/fluid/thin_wall/markers.hpp"
+#include "valvefsi/fluid/thin_wall/polyline.hpp"
+
+namespace valvefsi::fluid::thin_wall {
+
+struct ThinWallSettings {
+  // Spacing of the closest-point virtual lattice over dp (the prototype's dp/2).
+  double virtual_spacing_ratio = 0.5;
+  // Distance from the wall (over dp) at which a put-back particle or a shifted particle must
+  // stay at least.
+  double clearance_ratio = 0.1;
+  // Only virtual points in the wall's true shadow (segment from the particle crosses the
+  // wall) count. If false, the whole half-plane lattice behind the closest point counts
+  // (a measured alternative; it over-fills the kernel beyond a free edge).
+  bool shadow_only = true;
+};
+
+// What the model knows of one particle after classify (sorted index).
+struct NearWall {
+  ClosestPoint closest;
+  bool near = false;  // within one kernel support of the wall
+};
+
+struct WallCounters {
+  std::size_t corrections = 0;  // put-backs after a crossing, since the start
+  std::size_t leaks = 0;        // particles found on the other side without a correction
+  std::size_t rejected_shifts = 0;
+};
+
+class TwoSidedWall {
+ public:
+  TwoSidedWall(Polyline wall, const FluidSettings<2>& fluid, ThinWallSettings settings = {});
+
+  Polyline& wall() { return wall_; }
+  const Polyline& wall() const { return wall_; }
+  const MarkerSet& markers() const { return markers_; }
+  const ThinWallSettings& settings() const { return settings_; }
+  const WallCounters& counters() const { return counters_; }
+  const NearWall& near_wall(std::size_t i) const { return near_[i]; }
+
+  // After every sort: closest points, sides and candidate segments of all particles, and the
+  // leak check of fluid particles against their remembered side (by particle id).
+  void classify(const Particles<2>& particles);
+  // True when particles a and b (sorted indices) are on opposite sides of the wall.
+  bool blocked(std::uint32_t a, std::uint32_t b, const Particles<2>& particles) const;
+  // Per-side wall states of every marker (needs the fluid's pressure).
+  void update_marker_states(const Particles<2>& particles, const CellGrid<2>& grid);
+  // Adds the virtual layers' terms to the fluid's acceleration, density rate and (if sized)
+  // kernel sum and gradient; sets every marker's force to the reaction. Call after the
+  // fluid-fluid pass has written the rates.
+  void add_wall_rates(Particles<2>& particles);
+
+  // Before the drift: remember the particles' positions (current order) and the wall's nodes.
+  void begin_step(const Particles<2>& particles);
+  // After the drift and after the wall moved: put back particles whose path crossed it.
+  void correct_crossings(Particles<2>& particles);
+  // Whether moving fluid particle i (sorted index) from its position by `shift` is allowed.
+  bool accept_shift(const Particles<2>& particles, std::size_t i, const Vec2& shift);
+
+  // Sum of the virtual-layer kernel weights seen by particle i at the last add_wall_rates
+  // (diagnostics of kernel completeness near the edge).
+  float virtual_kernel_sum(std::size_t i) const { return i < virtual_kernel_sum_.size() ? virtual_kernel_sum_[i] : 0.0f; }
+
+ private:
+  Polyline wall_;
+  MarkerSet markers_;
+  FluidSettings<2> fluid_;
+  ThinWallSettings settings_;
+  WallCounters counters_;
+  std::vector<NearWall> near_;
+  std::vector<std::vector<std::uint32_t>> candidates_;
+  std::vector<std::int8_t> side_by_id_;       // remembered side of each particle id (0: unknown)
+  std::vector<std::uint8_t> corrected_by_id_;  // put back during the current step
+  std::vector<Vec2> start_position_;
+  std::vector<Vec2> previous_by_id_;  // position at the start of the step, by particle id
+  std::vector<Vec2> start_nodes_;
+  std::vector<float> virtual_kernel_sum_;
+  std::array<double, 4> wall_box_{};  // the wall's bounding box: xmin, ymin, xmax, ymax
+};
+
+}  // namespace valvefsi::fluid::thin_wall

@@ -1,0 +1,58 @@
+#include "valvefsi/fluid/thin_wall/scenes_2d.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace valvefsi::fluid::thin_wall {
+
+ThinWallCase2D two_level_tank(double dp, double left_level, double right_level, double gap) {
+  ThinWallCase2D c;
+  auto& s = c.fluid;
+  s.particle_spacing = dp;
+  s.rest_density = 1000.0;
+  s.dynamic_viscosity = 1e-3;
+  s.artificial_viscosity = 0.02;  // damps the start-up's acoustic transient
+  s.gravity = {0.0, -9.81};
+  s.sound_speed = 15.0 * std::sqrt(9.81 * std::max(left_level, right_level));
+  s.domain_lower = {-0.2, -0.2};
+  s.domain_upper = {1.2, 1.5};
+  c.scene.walls.push_back(container_box<2>({0.0, 0.0}, {1.0, 1e9}));
+  c.scene.fluid.push_back({{0.0, 0.0}, {0.5, left_level}, {}, {}});
+  c.scene.fluid.push_back({{0.5, 0.0}, {1.0, right_level}, {}, {}});
+  const double bottom = gap > 0 ? gap : -3.0 * dp;
+  c.wall = Polyline::at_rest({{0.5, bottom}, {0.5, 1.2}});
+  return c;
+}
+
+ThinWallCase2D oscillating_plate_box(double dp, const OscillatingPlate& plate) {
+  ThinWallCase2D c;
+  auto& s = c.fluid;
+  s.particle_spacing = dp;
+  s.rest_density = 1000.0;
+  s.dynamic_viscosity = plate.viscosity;
+  const double omega = 2.0 * std::numbers::pi / plate.period;
+  const double speed = plate.amplitude * omega;
+  // Edge speeds reach a few times the plate's; c0 keeps the box's acoustic modes far above
+  // the forcing (L / c0 << period).
+  s.sound_speed = std::max(20.0 * speed, 40.0 * plate.box_length / plate.period);
+  const double L = plate.box_length, H = plate.box_height;
+  s.domain_lower = {-L / 2 - 0.2 * L, -H / 2 - 0.2 * H};
+  s.domain_upper = {L / 2 + 0.2 * L, H / 2 + 0.2 * H};
+  c.scene.walls.push_back(container_box<2>({-L / 2, -H / 2}, {L / 2, H / 2}));
+  c.scene.fluid.push_back({{-L / 2, -H / 2}, {L / 2, H / 2}, {}, [](const Vec<2>&) { return 0.0; }});
+  // Lattice offset so that the plate's line x = 0 lies half-way between particle columns.
+  c.scene.lattice_origin = {0.0, 0.0};
+  const double half = plate.plate_width / 2;
+  c.wall = Polyline::at_rest({{-plate.amplitude, -half}, {-plate.amplitude, half}});
+  const double A = plate.amplitude;
+  c.motion = [A, omega, half](double t, Polyline& w) {
+    // X = -A cos(wt): starts at rest (no impulsive start), centred after the first period.
+    const double x = -A * std::cos(omega * t), v = A * omega * std::sin(omega * t), a = A * omega * omega * std::cos(omega * t);
+    w.position = {{x, -half}, {x, half}};
+    w.velocity = {{v, 0.0}, {v, 0.0}};
+    w.acceleration = {{a, 0.0}, {a, 0.0}};
+  };
+  return c;
+}
+
+}  // namespace valvefsi::fluid::thin_wall

@@ -1,0 +1,335 @@
+#include "valvefsi/fluid/thin_wall/two_sided_wall.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "valvefsi/fluid/equation_of_state.hpp"
+#include "valvefsi/fluid/kernels.hpp"
+
+namespace valvefsi::fluid::thin_wall {
+namespace {
+
+double dot(const Vec2& a, const Vec2& b) { return a[0] * b[0] + a[1] * b[1]; }
+
+Vec2 position_of(const Particles<2>& p, std::size_t i) { return {p.position[0][i], p.position[1][i]}; }
+
+// Cell of a point in the grid's numbering (x fastest), clamped into the grid.
+std::size_t cell_of_point(const CellGrid<2>& grid, const Vec2& x) {
+  std::size_t c = 0;
+  for (int d = 1; d >= 0; --d) {
+    int k = static_cast<int>(std::floor((x[d] - grid.lower()[d]) / grid.cell_size(d)));
+    k = std::clamp(k, 0, grid.cells_along(d) - 1);
+    c = c * static_cast<std::size_t>(grid.cells_along(d)) + static_cast<std::size_t>(k);
+  }
+  return c;
+}
+
+}  // namespace
+
+TwoSidedWall::TwoSidedWall(Polyline wall, const FluidSettings<2>& fluid, ThinWallSettings settings)
+    : wall_(std::move(wall)), markers_(wall_, fluid.particle_spacing), fluid_(fluid), settings_(settings) {}
+
+void TwoSidedWall::classify(const Particles<2>& p) {
+  const std::size_t n = p.size();
+  near_.assign(n, NearWall{});
+  candidates_.resize(n);
+  std::uint32_t max_id = 0;
+  for (std::size_t i = 0; i < n; ++i) max_id = std::max(max_id, p.id[i]);
+  if (side_by_id_.size() <= max_id) side_by_id_.resize(max_id + 1, 0);
+  if (corrected_by_id_.size() <= max_id) corrected_by_id_.resize(max_id + 1, 0);
+
+  wall_box_ = {wall_.position[0][0], wall_.position[0][1], wall_.position[0][0], wall_.position[0][1]};
+  for (const auto& x : wall_.position) {
+    wall_box_[0] = std::min(wall_box_[0], x[0]);
+    wall_box_[1] = std::min(wall_box_[1], x[1]);
+    wall_box_[2] = std::max(wall_box_[2], x[0]);
+    wall_box_[3] = std::max(wall_box_[3], x[1]);
+  }
+  const double R = fluid_.support_radius();
+  std::size_t leaks = 0;
+  const auto count = static_cast<std::ptrdiff_t>(n);
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : leaks)
+  for (std::ptrdiff_t ii = 0; ii < count; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    candidates_[i].clear();
+    const std::uint32_t id = p.id[i];
+    if (p.kind[i] == Kind::lost) continue;
+    const Vec2 x = position_of(p, i);
+    if (x[0] < wall_box_[0] - R || x[0] > wall_box_[2] + R || x[1] < wall_box_[1] - R || x[1] > wall_box_[3] + R) {
+      if (p.kind[i] == Kind::fluid) side_by_id_[id] = 0;
+      continue;
+    }
+    segments_near(wall_, x, R, candidates_[i]);
+    if (candidates_[i].empty()) {
+      if (p.kind[i] == Kind::fluid) side_by_id_[id] = 0;
+      continue;
+    }
+    NearWall& nw = near_[i];
+    nw.closest = closest_point(wall_, candidates_[i], x);
+    nw.near = true;
+    if (p.kind[i] != Kind::fluid) continue;
+    // A particle may change side only around a free end or through a put-back; otherwise it
+    // leaked (entering the near zone from outside cannot be a crossing).
+    auto& remembered = side_by_id_[id];
+    const auto side = static_cast<std::int8_t>(nw.closest.side);
+    // A straight step from the last position that misses the wall went round a free end
+    // (the side test alone would call that a leak when the end of the step is no longer
+    // beyond the tip).
+    if (remembered != 0 && remembered != side && !nw.closest.at_free_end && !corrected_by_id_[id] &&
+        (id >= previous_by_id_.size() || crosses(wall_, previous_by_id_[id], x)))
+      ++leaks;
+    remembered = side;
+  }
+  counters_.leaks += leaks;
+}
+
+bool TwoSidedWall::blocked(std::uint32_t a, std::uint32_t b, const Particles<2>& p) const {
+  if (!near_[a].near || !near_[b].near) return false;
+  return first_crossing(wall_, candidates_[a], position_of(p, a), position_of(p, b)).has_value();
+}
+
+void TwoSidedWall::update_marker_states(const Particles<2>& p, const CellGrid<2>& grid) {
+  const double R = fluid_.support_radius();
+  const double tiny = 1e-6 * fluid_.particle_spacing;
+  const auto count = static_cast<std::ptrdiff_t>(markers_.size());
+  with_kernel<2>(fluid_.kernel, fluid_.smoothing_length(), [&](const auto& W) {
+#pragma omp parallel for schedule(dynamic, 8)
+    for (std::ptrdiff_t mm = 0; mm < count; ++mm) {
+      Marker& m = markers_[static_cast<std::size_t>(mm)];
+      const Vec2 xm = wall_.point(m.segment, m.t);
+      const Vec2 nm = wall_.normal(m.segment);
+      const Vec2 am = wall_.acceleration_at(m.segment, m.t);
+      std::array<NeighbourSegment<2>, 9> segments;
+      const int segment_count = grid.neighbour_segments(cell_of_point(grid, xm), segments);
+      double sw[2] = {0, 0}, sp[2] = {0, 0}, srr[2][2] = {{0, 0}, {0, 0}}, sv[2][2] = {{0, 0}, {0, 0}};
+      for (int s = 0; s < segment_count; ++s) {
+        const auto& seg = segments[s];
+        for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
+          if (p.kind[b] != Kind::fluid || !near_[b].near) continue;
+          const Vec2 xb{p.position[0][b] + seg.shift[0], p.position[1][b] + seg.shift[1]};
+          const Vec2 r{xm[0] - xb[0], xm[1] - xb[1]};
+          const double dist = std::sqrt(dot(r, r));
+          if (dist >= R) continue;
+          const int side = near_[b].closest.side;
+          // The marker as seen from b's side: nothing of the wall may lie in between.
+          const Vec2 target{xm[0] + side * tiny * nm[0], xm[1] + side * tiny * nm[1]};
+          if (first_crossing(wall_, candidates_[b], xb, target)) continue;
+          const double w = W.value(static_cast<float>(dist));
+          const int k = side_index(side);
+          const double rho_b = fluid_.rest_density + p.density_excess[b];
+          sw[k] += w;
+          sp[k] += p.pressure[b] * w;
+          for (int d = 0; d < 2; ++d) {
+            srr[k][d] += rho_b * r[d] * w;
+            sv[k][d] += p.velocity[d][b] * w;
+          }
+        }
+      }
+      for (int k = 0; k < 2; ++k) {
+        SideState& st = m.side[k];
+        st.weight = sw[k];
+        if (sw[k] > 0) {
+          // Adami, Hu & Adams 2012, eq. 27, with the wall's acceleration.
+          double pw = sp[k];
+          for (int d = 0; d < 2; ++d) pw += (fluid_.gravity[d] - am[d]) * srr[k][d];
+          st.pressure = pw / sw[k];
+          st.extrapolated_velocity = {sv[k][0] / sw[k], sv[k][1] / sw[k]};
+        } else {
+          st.pressure = fluid_.background_pressure;
+          st.extrapolated_velocity = wall_.velocity_at(m.segment, m.t);
+        }
+      }
+    }
+  });
+}
+
+void TwoSidedWall::add_wall_rates(Particles<2>& p) {
+  const double dp = fluid_.particle_spacing;
+  const double R = fluid_.support_radius();
+  const double delta = settings_.virtual_spacing_ratio * dp;
+  const int layers = static_cast<int>(std::ceil(R / delta));
+  const double rho0 = fluid_.rest_density;
+  const double mass_a = fluid_.particle_mass();
+  const double mass_v = rho0 * delta * delta;
+  const double two_mu = 2.0 * fluid_.dynamic_viscosity;
+  const double alpha_c0 = fluid_.artificial_viscosity * fluid_.sound_speed;
+  const double h = fluid_.smoothing_length();
+  const double eta2 = 0.01 * h * h;
+  const LinearMieGruneisen eos{rho0, fluid_.sound_speed};
+  const bool with_kernel_sum = p.kernel_sum.size() == p.size();
+  virtual_kernel_sum_.assign(p.size(), 0.0f);
+
+  const int threads = omp_get_max_threads();
+  std::vector<Vec2> per_thread(static_cast<std::size_t>(threads) * markers_.size(), Vec2{0.0, 0.0});
+  const auto count = static_cast<std::ptrdiff_t>(p.size());
+  with_kernel<2>(fluid_.kernel, h, [&](const auto& W) {
+#pragma omp parallel for schedule(dynamic, 16)
+    for (std::ptrdiff_t aa = 0; aa < count; ++aa) {
+      const auto a = static_cast<std::size_t>(aa);
+      if (p.kind[a] != Kind::fluid || !near_[a].near) continue;
+      Vec2* forces = per_thread.data() + static_cast<std::size_t>(omp_get_thread_num()) * markers_.size();
+      const ClosestPoint& c = near_[a].closest;
+      const Vec2 xa = position_of(p, a);
+      // Lattice axes: n from the closest point towards the particle (rotates smoothly around
+      // a free end), t along the wall.
+      Vec2 n{xa[0] - c.point[0], xa[1] - c.point[1]};
+      const double nl = std::sqrt(dot(n, n));
+      if (nl > 1e-9 * dp) {
+        n = {n[0] / nl, n[1] / nl};
+      } else {
+        n = wall_.normal(c.segment);
+        n = {c.side * n[0], c.side * n[1]};
+      }
+      const Vec2 t{-n[1], n[0]};
+      const int k_side = side_index(c.side);
+      const double rho_a = rho0 + p.density_excess[a];
+      const double inv_a = 1.0 / rho_a;
+      const double p_a = p.pressure[a];
+      const Vec2 va{p.velocity[0][a], p.velocity[1][a]};
+      const Vec2 vva{p.viscous_velocity[0][a], p.viscous_velocity[1][a]};
+      double acc[2] = {0, 0}, cont = 0, csum = 0, cg[2] = {0, 0}, wsum = 0;
+      for (int j = 1; j <= layers; ++j) {
+        const double depth = (j - 0.5) * delta;
+        for (int i = -layers; i <= layers; ++i) {
+          const Vec2 xv{c.point[0] + i * delta * t[0] - depth * n[0], c.point[1] + i * delta * t[1] - depth * n[1]};
+          const Vec2 r{xa[0] - xv[0], xa[1] - xv[1]};
+          const double r2 = dot(r, r);
+          if (r2 >= R * R) continue;
+          std::size_t seg;
+          double tw;
+          if (settings_.shadow_only) {
+            const auto hit = first_crossing(wall_, candidates_[a], xa, xv);
+            if (!hit) continue;
+            seg = hit->segment;
+            tw = hit->t;
+          } else {
+            const ClosestPoint cv = closest_point(wall_, candidates_[a], xv);
+            seg = cv.segment;
+            tw = cv.t;
+          }
+          // That side's wall state at the wall point q where the particle sees the virtual
+          // point, extrapolated hydrostatically (with the wall's acceleration) to it.
+          const Vec2 q = wall_.point(seg, tw);
+          const MarkerWeights mw = markers_.weights_at(markers_.arc_length(seg, tw));
+          const SideState& s0 = markers_[mw.first].side[k_side];
+          const SideState& s1 = markers_[mw.second].side[k_side];
+          const Vec2 vw = wall_.velocity_at(seg, tw);
+          const Vec2 aw = wall_.acceleration_at(seg, tw);
+          double p_v = mw.w0 * s0.pressure + mw.w1 * s1.pressure;
+          for (int d = 0; d < 2; ++d) p_v += rho0 * (fluid_.gravity[d] - aw[d]) * (xv[d] - q[d]);
+          Vec2 vv_v;
+          for (int d = 0; d < 2; ++d)
+            vv_v[d] = 2.0 * vw[d] - (mw.w0 * s0.extrapolated_velocity[d] + mw.w1 * s1.extrapolated_velocity[d]);
+          const double inv_v = 1.0 / (rho0 + eos.density_excess(p_v - fluid_.background_pressure));
+          const double dist = std::sqrt(r2);
+          const double F = W.gradient_factor(static_cast<float>(dist));
+          const double wv = W.value(static_cast<float>(dist));
+          const double inv_rr = inv_a * inv_v;
+          const double vdx = (va[0] - vw[0]) * r[0] + (va[1] - vw[1]) * r[1];
+          double radial = -(p_a + p_v) * inv_rr;
+          if (alpha_c0 > 0) radial += alpha_c0 * h * std::min(vdx, 0.0) / (r2 + eta2) * 0.5 * (inv_a + inv_v);
+          radial *= F;
+          const double viscous = two_mu * inv_rr * F;
+          double da[2];
+          for (int d = 0; d < 2; ++d) da[d] = mass_v * (radial * r[d] + viscous * (vva[d] - vv_v[d]));
+          acc[0] += da[0];
+          acc[1] += da[1];
+          cont += mass_v * vdx * F;
+          csum += mass_v * wv * inv_v;
+          cg[0] += mass_v * F * r[0] * inv_v;
+          cg[1] += mass_v * F * r[1] * inv_v;
+          wsum += wv * delta * delta;
+          // Action = reaction: the opposite force goes to the markers that carried the state.
+          for (int d = 0; d < 2; ++d) {
+            forces[mw.first][d] -= mw.w0 * mass_a * da[d];
+            forces[mw.second][d] -= mw.w1 * mass_a * da[d];
+          }
+        }
+      }
+      for (int d = 0; d < 2; ++d) p.acceleration[d][a] += static_cast<float>(acc[d]);
+      p.density_rate[a] += static_cast<float>(cont);
+      if (with_kernel_sum) {
+        p.kernel_sum[a] += static_cast<float>(csum);
+        for (int d = 0; d < 2; ++d) p.kernel_sum_gradient[d][a] += static_cast<float>(cg[d]);
+      }
+      virtual_kernel_sum_[a] = static_cast<float>(wsum);
+    }
+  });
+  for (auto& m : markers_.markers()) m.force = {0.0, 0.0};
+  for (int th = 0; th < threads; ++th)
+    for (std::size_t m = 0; m < markers_.size(); ++m)
+      for (int d = 0; d < 2; ++d) markers_[m].force[d] += per_thread[static_cast<std::size_t>(th) * markers_.size() + m][d];
+}
+
+void TwoSidedWall::begin_step(const Particles<2>& p) {
+  start_position_.resize(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) start_position_[i] = position_of(p, i);
+  start_nodes_ = wall_.position;
+  std::uint32_t max_id = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) max_id = std::max(max_id, p.id[i]);
+  previous_by_id_.resize(static_cast<std::size_t>(max_id) + 1);
+  for (std::size_t i = 0; i < p.size(); ++i) previous_by_id_[p.id[i]] = start_position_[i];
+  std::fill(corrected_by_id_.begin(), corrected_by_id_.end(), std::uint8_t{0});
+}
+
+void TwoSidedWall::correct_crossings(Particles<2>& p) {
+  const double R = fluid_.support_radius();
+  const double clearance = settings_.clearance_ratio * fluid_.particle_spacing;
+  std::size_t corrections = 0;
+  const auto count = static_cast<std::ptrdiff_t>(p.size());
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : corrections)
+  for (std::ptrdiff_t ii = 0; ii < count; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    if (p.kind[i] != Kind::fluid) continue;
+    const Vec2 x0 = start_position_[i];
+    Vec2 x1 = position_of(p, i);
+    if (x0[0] < wall_box_[0] - R || x0[0] > wall_box_[2] + R || x0[1] < wall_box_[1] - R || x0[1] > wall_box_[3] + R) continue;
+    const auto hit = swept_crossing(start_nodes_, wall_.position, x0, x1);
+    if (!hit) continue;
+    const std::size_t k = hit->segment;
+    // Side at the start of the step, from the segment that was crossed.
+    const Vec2 a0 = start_nodes_[k], b0 = start_nodes_[k + 1];
+    const double c0 = (b0[0] - a0[0]) * (x0[1] - a0[1]) - (b0[1] - a0[1]) * (x0[0] - a0[0]);
+    const double side = c0 >= 0.0 ? 1.0 : -1.0;
+    const Vec2 nk = wall_.normal(k);
+    const Vec2 n{side * nk[0], side * nk[1]};
+    const Vec2 a1 = wall_.position[k];
+    const double signed_distance = (x1[0] - a1[0]) * n[0] + (x1[1] - a1[1]) * n[1];
+    const double depth = std::max(-signed_distance, 0.0);
+    const double move = depth + std::max(depth, clearance);
+    for (int d = 0; d < 2; ++d) p.position[d][i] = x1[d] + move * n[d];
+    // Reflect the velocity relative to the wall, normal part only, if it points into the wall.
+    const Vec2 vw = wall_.velocity_at(k, hit->t);
+    const double vn = (p.velocity[0][i] - vw[0]) * n[0] + (p.velocity[1][i] - vw[1]) * n[1];
+    if (vn < 0.0) {
+      for (int d = 0; d < 2; ++d) {
+        p.velocity[d][i] = static_cast<float>(p.velocity[d][i] - 2.0 * vn * n[d]);
+        p.viscous_velocity[d][i] = p.velocity[d][i];
+      }
+    }
+    if (p.id[i] < corrected_by_id_.size()) corrected_by_id_[p.id[i]] = 1;
+    ++corrections;
+  }
+  counters_.corrections += corrections;
+}
+
+bool TwoSidedWall::accept_shift(const Particles<2>& p, std::size_t i, const Vec2& shift) {
+  const Vec2 x = position_of(p, i);
+  if (i < near_.size() && !near_[i].near) return true;
+  const Vec2 y{x[0] + shift[0], x[1] + shift[1]};
+  bool ok = !crosses(wall_, x, y);
+  if (ok) {
+    const double clearance = settings_.clearance_ratio * fluid_.particle_spacing;
+    const double after = closest_point(wall_, y).distance;
+    ok = !(after < clearance && after < closest_point(wall_, x).distance);
+  }
+  if (!ok) {
+#pragma omp atomic
+    ++counters_.rejected_shifts;
+  }
+  return ok;
+}
+
+}  // namespace valvefsi::fluid::thin_wall

@@ -114,7 +114,7 @@ TEST(ThinWallGeometry, MarkersTileTheWallAndInterpolateConservatively) {
   for (const auto& m : markers.markers()) total += m.area;
   EXPECT_DOUBLE_EQ(total, 3.0);
   EXPECT_DOUBLE_EQ(markers.total_length(), 3.0);
-  EXPECT_DOUBLE_EQ(markers.arc_length(wall, 1, 0.5), 2.0);
+  EXPECT_DOUBLE_EQ(markers.arc_length(1, 0.5), 2.0);
   // Halfway between markers 1 (s = 1/2) and 2 (s = 5/6).
   const auto w = markers.weights_at(2.0 / 3.0);
   EXPECT_EQ(w.first, 1u);

@@ -150,8 +150,8 @@ class ValveEvents:
     """Times (s) from the free-edge radial-position curve; levels are fractions of its range."""
     opening_start: float   # first upward crossing of the low level
     opening_end: float     # first upward crossing of the high level after it
-    closing_start: float   # last downward crossing of the high level before closing_end
-    closing_end: float     # last downward crossing of the low level
+    closing_start: float   # last downward crossing of the high level
+    closing_end: float     # first downward crossing of the low level after it
     rvot: float            # rapid valve opening time = opening_end - opening_start
     rvct: float            # rapid valve closing time = closing_end - closing_start
     et: float              # ejection time = closing_end - opening_start
@@ -172,9 +172,9 @@ def valve_events(t, radial_position, low: float = 0.1, high: float = 0.9) -> Val
     range (the open plateau, so that an opening overshoot or flutter does not move the
     levels), L = r_closed + low (r_open - r_closed) and H = r_closed + high (r_open - r_closed):
     opening runs from the first upward crossing of L to
-    the next upward crossing of H; closing from the last downward crossing of H (before the
-    final closure) to the last downward crossing of L; ejection from opening start to closing
-    end. Crossing times are interpolated linearly between samples."""
+    the next upward crossing of H; closing from the last downward crossing of H to the next
+    downward crossing of L (so rebounds after closure that stay below H do not count);
+    ejection from opening start to closing end. Crossing times are interpolated linearly."""
     t = np.asarray(t, dtype=float)
     r = np.asarray(radial_position, dtype=float)
     if t.ndim != 1 or t.shape != r.shape or len(t) < 3 or np.any(np.diff(t) <= 0):
@@ -190,13 +190,15 @@ def valve_events(t, radial_position, low: float = 0.1, high: float = 0.9) -> Val
     opening_start = up_lo[0]
     up_hi = _crossings(t, r, hi, True)
     up_hi = up_hi[up_hi > opening_start]
-    down_lo = _crossings(t, r, lo, False)
-    if len(up_hi) == 0 or len(down_lo) == 0:
-        raise ValueError("valve_events: r(t) does not open and close within the samples given")
-    closing_end = down_lo[-1]
     down_hi = _crossings(t, r, hi, False)
-    down_hi = down_hi[down_hi < closing_end]
+    down_lo = _crossings(t, r, lo, False)
+    if len(up_hi) == 0 or len(down_hi) == 0:
+        raise ValueError("valve_events: r(t) does not open and close within the samples given")
     opening_end, closing_start = up_hi[0], down_hi[-1]
+    down_lo = down_lo[down_lo > closing_start]
+    if len(down_lo) == 0:
+        raise ValueError(f"valve_events: r(t) does not fall below {low:.0%} of its range after closing starts")
+    closing_end = down_lo[0]
     return ValveEvents(opening_start, opening_end, closing_start, closing_end,
                        opening_end - opening_start, closing_end - closing_start, closing_end - opening_start)
 

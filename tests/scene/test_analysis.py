@@ -134,6 +134,13 @@ class ValveEvents(unittest.TestCase):
         self.assertAlmostEqual(events.rvct, 0.8 * 0.030, delta=1e-6)
         self.assertAlmostEqual(events.rvot, 0.8 * 0.020, delta=1e-6)
 
+    def test_rebounds_after_closure_do_not_move_the_closing_end(self):
+        t = np.linspace(0.0, 0.8, 8001)
+        bounce = 2e-3 * np.exp(-((t - 0.300) / 0.010) ** 2)   # 2 mm rebound (> L, < H) at 300 ms
+        events = valve_events(t, self.trapezoid(t) + bounce)
+        self.assertAlmostEqual(events.closing_end, 0.200 + 0.9 * 0.030, delta=1e-6)
+        self.assertAlmostEqual(events.et, 0.227 - 0.012, delta=1e-6)
+
     def test_a_valve_that_never_opens_is_reported(self):
         t = np.linspace(0, 0.8, 81)
         with self.assertRaisesRegex(ValueError, "never changes"):

@@ -1,0 +1,76 @@
+// The fluid section of a case file becomes settings, geometry, plates and probes; mistakes are
+// reported with the file, the field, the value and what is allowed.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "valvefsi/case/case_loader.hpp"
+#include "valvefsi/fluid/case_setup.hpp"
+
+namespace valvefsi::fluid {
+namespace {
+
+const std::string kChannel = R"(
+run { end_time: 0.1 dimension: 2 }
+fluid {
+  particle_spacing: 0.01
+  kernel: WENDLAND_C2
+  sound_speed: 30
+  gravity: [0, -9.81]
+  domain_lower: [-0.1, -0.1]
+  domain_upper: [1.1, 0.3]
+  walls { half_space { point: [0, 0] normal: [0, 1] } }
+  walls { half_space { point: [0, 0.2] normal: [0, -1] } }
+  fluid_blocks { box { lower: [0, 0] upper: [1, 0.2] } }
+  plates {
+    shape { solid_box { lower: [-0.04, 0] upper: [0, 0.2] } }
+    normal: [1, 0]  area: 0.2  pressure_mmHg: 10
+  }
+  probes {
+    pressure_points { name: "mid" position: [0.5, 0.1] }
+    flow_planes { name: "mid" point: [0.5, 0.1] normal: [1, 0] }
+  }
+}
+)";
+
+TEST(CaseSetup, ReadsFluidSectionWithDefaults) {
+  const cases::Case c = parse_case_text(kChannel, "channel.textproto");
+  const FluidSetup<2> setup = fluid_setup_from_case<2>(c, "channel.textproto");
+  EXPECT_DOUBLE_EQ(setup.settings.particle_spacing, 0.01);
+  EXPECT_EQ(setup.settings.kernel, KernelType::wendland_c2);
+  EXPECT_DOUBLE_EQ(setup.settings.rest_density, 1056.0);       // default: blood
+  EXPECT_DOUBLE_EQ(setup.settings.dynamic_viscosity, 0.0035);  // default: blood
+  EXPECT_DOUBLE_EQ(setup.settings.gravity[1], -9.81);
+  ASSERT_EQ(setup.plates.size(), 1u);
+  EXPECT_NEAR(setup.plates[0].pressure(0.3), 10 * 133.322387415, 1e-9);
+  EXPECT_EQ(setup.probes.pressure_points.at(0).name, "mid");
+  // The scene fills: 100 x 20 fluid particles, plate particles as body 1.
+  FluidSolver<2> solver = make_solver<2>(setup);
+  EXPECT_EQ(solver.particles().count(Kind::fluid), 2000u);
+  EXPECT_GT(solver.plates()[0].mass, 0.0);
+}
+
+TEST(CaseSetup, WrongVectorLengthNamesFileFieldAndAllowed) {
+  std::string text = kChannel;
+  text.replace(text.find("gravity: [0, -9.81]"), 19, "gravity: [0, -9.81, 0]");
+  const cases::Case c = parse_case_text(text, "channel.textproto");
+  try {
+    fluid_setup_from_case<2>(c, "channel.textproto");
+    FAIL() << "expected a CaseError";
+  } catch (const CaseError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("channel.textproto"), std::string::npos) << message;
+    EXPECT_NE(message.find("fluid.gravity"), std::string::npos) << message;
+    EXPECT_NE(message.find("has 3 entries"), std::string::npos) << message;
+    EXPECT_NE(message.find("exactly 2"), std::string::npos) << message;
+  }
+}
+
+TEST(CaseSetup, OutOfRangeValueIsRejectedByTheSchema) {
+  std::string text = kChannel;
+  text.replace(text.find("sound_speed: 30"), 15, "sound_speed: -3");
+  EXPECT_THROW(parse_case_text(text, "channel.textproto"), CaseError);
+}
+
+}  // namespace
+}  // namespace valvefsi::fluid

@@ -124,6 +124,7 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.time_step_update_interval = solid.time_step_update_interval();
   solver_options.mass_damping_per_s = solid.mass_damping_per_s();
   solver_options.max_time_step = solid.max_time_step();
+  solver_options.contact_stiffness_factor = solid.contact_stiffness_factor();
 
   Material material = material_from_case(solid, source);
   setup.notes.push_back(fmt::format("mesh {}: {} nodes, {} triangles; material {}; {} fixed nodes ({}), {} edges",
@@ -152,6 +153,22 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
     setup.notes.push_back(fmt::format("contact plane '{}': penalty contact of the mid-surface offset by t/2 "
                                       "(leaflet-leaflet contact is NOT implemented yet)", name));
     setup.solver->add_contact_plane(plane);
+  }
+  // Leaflet-leaflet contact between the surfaces named leaflet_0, leaflet_1, ...
+  std::vector<int> surface_of_node(static_cast<std::size_t>(mesh.num_nodes()), -1);
+  int leaflets = 0;
+  for (; mesh.node_sets.count(fmt::format("leaflet_{}", leaflets)) != 0; ++leaflets) {
+    for (const std::int64_t n : mesh.node_sets.at(fmt::format("leaflet_{}", leaflets))) {
+      surface_of_node[static_cast<std::size_t>(n)] = leaflets;
+    }
+  }
+  if (solid.disable_leaflet_contact()) {
+    setup.notes.push_back("leaflet-leaflet contact OFF (solid.disable_leaflet_contact)");
+  } else if (leaflets >= 2) {
+    setup.notes.push_back(fmt::format("leaflet-leaflet contact between {} leaflets (node sets leaflet_k)", leaflets));
+    setup.solver->enable_leaflet_contact(std::move(surface_of_node));
+  } else {
+    setup.notes.push_back(fmt::format("leaflet-leaflet contact not needed: {} leaflet node set(s)", leaflets));
   }
   return setup;
 }

@@ -77,11 +77,16 @@ void ShellSolver::add_contact_plane(const Plane& plane) {
   internal_force_current_ = false;
 }
 
+void ShellSolver::enable_leaflet_contact(std::vector<int> surface_of_node) {
+  leaflet_contact_.emplace(model_, std::move(surface_of_node));
+  internal_force_current_ = false;
+}
+
 void ShellSolver::compute_contact_force() {
   Eigen::Matrix3Xd& f = state_.contact_force;
   f.setZero();
   state_.nodes_in_contact = 0;
-  if (contact_planes_.empty()) return;
+  if (contact_planes_.empty() && !leaflet_contact_) return;
   // Penalty stiffness from the highest frequency the first step resolves, k = factor m (2/dt)^2,
   // then kept: a constant spring is conservative, and the step only shrinks as tissue stiffens.
   if (contact_omega2_ == 0.0) {
@@ -98,6 +103,10 @@ void ShellSolver::compute_contact_force() {
         ++state_.nodes_in_contact;
       }
     }
+  }
+  if (leaflet_contact_) {
+    state_.nodes_in_contact +=
+        leaflet_contact_->add_forces(model_, x, options_.contact_stiffness_factor * omega2, f);
   }
 }
 
@@ -239,7 +248,7 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
     apply_constraints(a);
 
     // A penalty spring of k = factor m omega^2 raises the node's frequency by sqrt(1 + factor).
-    double dt = contact_planes_.empty() ? state_.stable_step
+    double dt = contact_planes_.empty() && !leaflet_contact_ ? state_.stable_step
                                         : state_.stable_step / std::sqrt(1.0 + options_.contact_stiffness_factor);
     // Land exactly on t_end; avoid a sliver step by splitting the last two evenly.
     const double remaining = t_end - state_.time;

@@ -200,5 +200,53 @@ TEST(ShellDynamics, ContactPlaneStopsTheMidSurfaceHalfAThicknessAway) {
 }
 
 
+TEST(ShellDynamics, TwoLeafletsPressedTogetherStopAThicknessApart) {
+  // Two membranes 1 mm apart with normals facing each other; the pressure pushes both toward
+  // the other. Their mid-surfaces must stop one thickness apart (t/2 + t/2).
+  const double a = 0.01, t = 0.25e-3, spacing = 1e-3;
+  Mesh lower = rectangular_plate(a, a, 10, 10, t);
+  Mesh mesh = lower;
+  const auto n = lower.num_nodes();
+  mesh.nodes.conservativeResize(3, 2 * n);
+  mesh.nodes.rightCols(n) = lower.nodes;
+  mesh.nodes.rightCols(n).row(2).setConstant(spacing);
+  mesh.nodes.rightCols(n).row(0) = lower.nodes.row(0) * 1.0;  // same plan view
+  for (const auto& tri : lower.triangles) mesh.triangles.push_back({tri[0] + n, tri[2] + n, tri[1] + n});  // normal -z
+  mesh.triangle_thickness.assign(mesh.triangles.size(), t);
+  mesh.triangle_circumferential = Eigen::Vector3d::UnitX().replicate(1, static_cast<Eigen::Index>(mesh.triangles.size()));
+  mesh.triangle_radial = Eigen::Vector3d::UnitY().replicate(1, static_cast<Eigen::Index>(mesh.triangles.size()));
+  std::vector<std::int64_t> fixed;
+  std::vector<int> surface(static_cast<std::size_t>(2 * n), 0);
+  for (const char* side : {"left", "right", "top", "bottom"}) {
+    for (const auto i : lower.node_sets.at(side)) {
+      fixed.push_back(i);
+      fixed.push_back(i + n);
+    }
+  }
+  for (Eigen::Index i = n; i < 2 * n; ++i) surface[static_cast<std::size_t>(i)] = 1;
+  ShellModelOptions options;
+  options.fixed_nodes = fixed;
+  options.clamp_fixed_edges = false;
+  SolverOptions solver_options;
+  solver_options.mass_damping_per_s = 2000.0;
+  ShellSolver solver(build_shell_model(mesh, options), Material{NeoHookean{100e3}}, solver_options);
+  solver.set_pressure([](double) { return 2000.0; });
+  solver.enable_leaflet_contact(surface);
+  for (int k = 1; k <= 40; ++k) solver.advance_window(k * 1e-3);
+  const Eigen::Matrix3Xd& x = solver.state().position;
+  const auto centre = testing::grid_node(5, 5, 10);
+  const double gap = x(2, centre + n) - x(2, centre);
+  EXPECT_GT(solver.state().nodes_in_contact, 10);
+  EXPECT_GT(gap, 0.9 * t) << "mid-surfaces closer than 90 % of a thickness";
+  EXPECT_LT(gap, 1.02 * t) << "the leaflets touch";
+  EXPECT_LT(x(2, centre), spacing) << "no crossing";
+  // Node-to-triangle penalties are not exactly conservative (closest points switch faces).
+  EXPECT_LT(solver.state().energy.relative_balance_error(), 2e-2);
+  std::printf("leaflet contact: %lld steps, %lld candidate-list rebuilds, balance error %.2e\n",
+              static_cast<long long>(solver.state().step), static_cast<long long>(solver.leaflet_contact()->rebuilds()),
+              solver.state().energy.relative_balance_error());
+  EXPECT_LT(solver.leaflet_contact()->rebuilds(), solver.state().step / 2) << "candidate lists are reused";
+}
+
 }  // namespace
 }  // namespace valvefsi::solid

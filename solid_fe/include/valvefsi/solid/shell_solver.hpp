@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "valvefsi/solid/leaflet_contact.hpp"
 #include "valvefsi/solid/material.hpp"
 #include "valvefsi/solid/shell_model.hpp"
 
@@ -72,6 +73,10 @@ class ShellSolver {
   // Rigid plane the leaflet mid-surface may approach to half its thickness but not cross; the
   // plane's normal points to the side where the leaflet lives. Penalty on nodes.
   void add_contact_plane(const Plane& plane);
+  // Leaflet-leaflet contact between nodes and triangles of different surfaces (ids per node;
+  // empty: any non-incident triangle).
+  void enable_leaflet_contact(std::vector<int> surface_of_node);
+  const LeafletContact* leaflet_contact() const { return leaflet_contact_ ? &*leaflet_contact_ : nullptr; }
   void set_velocity(const Eigen::Matrix3Xd& velocity);  // initial condition (before the first step)
 
   // Advances to exactly t_end under `nodal_forces` (3 x nodes, N; constant over the window)
@@ -102,6 +107,7 @@ class ShellSolver {
   std::vector<std::int64_t> pressure_elements_;
   std::vector<SymmetryConstraint> symmetry_;
   std::vector<Plane> contact_planes_;
+  std::optional<LeafletContact> leaflet_contact_;
   double contact_omega2_ = 0.0;  // frequency^2 fixing the penalty stiffness, set at the first step
   Eigen::VectorXd half_thickness_;  // per node: half the largest adjacent element thickness
   std::vector<Eigen::Matrix3Xd> thread_forces_;  // per-thread accumulation, allocated once

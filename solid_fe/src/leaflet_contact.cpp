@@ -1,0 +1,126 @@
+#include "valvefsi/solid/leaflet_contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+#include <nanoflann.hpp>
+
+namespace valvefsi::solid {
+
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                          const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                                          Eigen::Vector3d& weights) {
+  // Inside the prism over the triangle: the projection onto its plane.
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  const double n2 = n.squaredNorm();
+  const Eigen::Vector3d q = p - (p - a).dot(n) / n2 * n;
+  const double wa = (b - q).cross(c - q).dot(n) / n2;
+  const double wb = (c - q).cross(a - q).dot(n) / n2;
+  const double wc = 1.0 - wa - wb;
+  if (wa >= 0 && wb >= 0 && wc >= 0) {
+    weights = {wa, wb, wc};
+    return q;
+  }
+  // Otherwise the nearest point of the three edges.
+  const std::array<Eigen::Vector3d, 3> v{a, b, c};
+  double best = HUGE_VAL;
+  Eigen::Vector3d best_point = a;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d& s = v[i];
+    const Eigen::Vector3d& e = v[(i + 1) % 3];
+    const double u = std::clamp((p - s).dot(e - s) / (e - s).squaredNorm(), 0.0, 1.0);
+    const Eigen::Vector3d point = s + u * (e - s);
+    const double d = (p - point).squaredNorm();
+    if (d < best) {
+      best = d;
+      best_point = point;
+      weights.setZero();
+      weights(i) = 1.0 - u;
+      weights((i + 1) % 3) = u;
+    }
+  }
+  return best_point;
+}
+
+LeafletContact::LeafletContact(const ShellModel& model, std::vector<int> surface_of_node)
+    : surface_of_node_(std::move(surface_of_node)) {
+  const Eigen::Index n = model.reference_positions.cols();
+  half_thickness_ = Eigen::VectorXd::Zero(n);
+  double max_thickness = 0.0, max_reach = 0.0;
+  for (const auto& el : model.elements) {
+    max_thickness = std::max(max_thickness, el.thickness);
+    const Eigen::Vector3d centroid = (model.reference_positions.col(el.nodes[0]) + model.reference_positions.col(el.nodes[1]) +
+                                      model.reference_positions.col(el.nodes[2])) / 3.0;
+    for (const auto a : el.nodes) {
+      half_thickness_(a) = std::max(half_thickness_(a), 0.5 * el.thickness);
+      max_reach = std::max(max_reach, (model.reference_positions.col(a) - centroid).norm());
+    }
+  }
+  margin_ = max_thickness;
+  // Stretch allowance: tissue rarely exceeds 30 % strain before the material guard stops it.
+  search_radius_ = 1.3 * max_reach + max_thickness + margin_;
+}
+
+void LeafletContact::rebuild(const ShellModel& model, const Eigen::Matrix3Xd& x) {
+  const auto num_elements = static_cast<Eigen::Index>(model.elements.size());
+  Eigen::Matrix3Xd centroids(3, num_elements);
+  for (Eigen::Index e = 0; e < num_elements; ++e) {
+    const auto& nodes = model.elements[static_cast<std::size_t>(e)].nodes;
+    centroids.col(e) = (x.col(nodes[0]) + x.col(nodes[1]) + x.col(nodes[2])) / 3.0;
+  }
+  using Tree = nanoflann::KDTreeEigenMatrixAdaptor<Eigen::Matrix3Xd, 3, nanoflann::metric_L2_Simple, false>;
+  const Tree tree(3, std::cref(centroids), 16);
+  pairs_.clear();
+  std::vector<std::pair<Eigen::Index, double>> matches;
+  const nanoflann::SearchParams params(32, 0.0f, false);
+  for (Eigen::Index i = 0; i < x.cols(); ++i) {
+    if (model.fixed[static_cast<std::size_t>(i)]) continue;
+    matches.clear();
+    const Eigen::Vector3d p = x.col(i);
+    tree.index->radiusSearch(p.data(), search_radius_ * search_radius_, matches, params);
+    for (const auto& [e, d2] : matches) {
+      const auto& nodes = model.elements[static_cast<std::size_t>(e)].nodes;
+      if (nodes[0] == i || nodes[1] == i || nodes[2] == i) continue;
+      if (!surface_of_node_.empty() &&
+          surface_of_node_[static_cast<std::size_t>(nodes[0])] == surface_of_node_[static_cast<std::size_t>(i)]) {
+        continue;
+      }
+      pairs_.emplace_back(static_cast<std::int32_t>(i), static_cast<std::int32_t>(e));
+    }
+  }
+  positions_at_build_ = x;
+  ++rebuilds_;
+}
+
+std::int64_t LeafletContact::add_forces(const ShellModel& model, const Eigen::Matrix3Xd& x,
+                                        double stiffness_per_mass, Eigen::Matrix3Xd& forces) {
+  if (positions_at_build_.cols() != x.cols() ||
+      (x - positions_at_build_).colwise().norm().maxCoeff() > 0.5 * margin_) {
+    rebuild(model, x);
+  }
+  std::int64_t in_contact = 0;
+  Eigen::Vector3d w;
+  for (const auto& [i, e] : pairs_) {
+    const ShellElement& el = model.elements[static_cast<std::size_t>(e)];
+    const Eigen::Vector3d p = x.col(i);
+    const Eigen::Vector3d c = closest_point_on_triangle(p, x.col(el.nodes[0]), x.col(el.nodes[1]), x.col(el.nodes[2]), w);
+    const Eigen::Vector3d separation = p - c;
+    const double distance = separation.norm();
+    const double gap = distance - (half_thickness_(i) + 0.5 * el.thickness);
+    if (gap >= 0.0) continue;
+    Eigen::Vector3d direction;
+    if (distance > 1e-9 * el.thickness) {
+      direction = separation / distance;
+    } else {  // on the mid-surface itself: push along the triangle's normal
+      direction = (x.col(el.nodes[1]) - x.col(el.nodes[0])).cross(x.col(el.nodes[2]) - x.col(el.nodes[0])).normalized();
+    }
+    const Eigen::Vector3d f = -stiffness_per_mass * model.nodal_mass(i) * gap * direction;
+    forces.col(i) += f;
+    for (int a = 0; a < 3; ++a) forces.col(el.nodes[a]) -= w(a) * f;
+    ++in_contact;
+  }
+  return in_contact;
+}
+
+}  // namespace valvefsi::solid

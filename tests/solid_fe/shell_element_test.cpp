@@ -9,6 +9,9 @@
 #include "test_meshes.hpp"
 #include "valvefsi/solid/hinge_angle.hpp"
 #include "valvefsi/solid/shell_forces.hpp"
+#include "valvefsi/solid/shell_solver.hpp"
+
+#include <omp.h>
 
 namespace valvefsi::solid {
 namespace {
@@ -159,6 +162,27 @@ TEST(ShellElement, BendingPatchTestRecoversCylinderCurvature) {
     ++checked;
   }
   EXPECT_GT(checked, 100);
+}
+
+TEST(ShellElement, ThreadedForcesEqualSerialForces) {
+  // Large enough for the threaded path: per-thread accumulation must give the serial sum.
+  const Mesh mesh = rectangular_plate(0.02, 0.02, 24, 24, 0.25e-3, false, 0.2);
+  const ShellModel model = build_shell_model(mesh, {});
+  ASSERT_GE(model.elements.size(), 1000u);
+  Eigen::Matrix3Xd v = Eigen::Matrix3Xd::Zero(3, mesh.num_nodes());
+  for (Eigen::Index n = 0; n < v.cols(); ++n) v(2, n) = std::sin(300.0 * mesh.nodes(0, n)) * mesh.nodes(1, n);
+  std::array<Eigen::Matrix3Xd, 2> forces;
+  const int saved = omp_get_max_threads();
+  for (int threads = 1; threads <= 2; ++threads) {
+    omp_set_num_threads(threads);
+    ShellSolver solver(model, Material{Mhgo{}});
+    solver.set_velocity(v);
+    solver.advance_window(2e-5);
+    forces[threads - 1] = solver.state().internal_force;
+  }
+  omp_set_num_threads(saved);
+  EXPECT_LT((forces[0] - forces[1]).cwiseAbs().maxCoeff(), 1e-10 * forces[0].cwiseAbs().maxCoeff());
+  EXPECT_GT(forces[0].cwiseAbs().maxCoeff(), 0.0);
 }
 
 }  // namespace

@@ -80,6 +80,14 @@ class Program:
                                         stdin=subprocess.DEVNULL, env=environment, start_new_session=True)
         self.reader = threading.Thread(target=self._pump, daemon=True)
         self.reader.start()
+        # When it ended, to tell the cause (the first to fail) from its consequences.
+        self.ended_at = None
+        self.waiter = threading.Thread(target=self._wait, daemon=True)
+        self.waiter.start()
+
+    def _wait(self):
+        self.process.wait()
+        self.ended_at = time.monotonic()
 
     def _pump(self):
         for raw in iter(self.process.stdout.readline, b""):
@@ -89,9 +97,9 @@ class Program:
             sys.stdout.flush()
 
     def exit_code(self):
-        code = self.process.poll()
-        if code is None:
+        if self.ended_at is None:
             return None
+        code = self.process.returncode
         return 128 - code if code < 0 else code
 
     def signal_group(self, sig):
@@ -118,7 +126,7 @@ def stop_all(programs, grace):
             print(f"run_case: {program.role} did not stop within {grace} s; killing it", file=sys.stderr, flush=True)
             program.signal_group(signal.SIGKILL)
     for program in running:
-        program.process.wait()
+        program.waiter.join()
 
 
 def main():
@@ -195,7 +203,7 @@ def main():
             break
         failed = [p for p in programs if p.exit_code() not in (None, 0)]
         if failed:
-            first = failed[0]
+            first = min(failed, key=lambda p: p.ended_at)
             exit_code = first.exit_code()
             others = [p.role for p in programs if p is not first and p.exit_code() is None]
             print(f"run_case: {first.role} failed with exit code {exit_code}"

@@ -15,14 +15,16 @@ std::string standin_exe(const std::string& name) { return std::string(VALVEFSI_T
 CoupledRun::CoupledRun(const RunSpec& spec) : dir(fresh_directory(spec.name)), case_file(dir / "case.textproto") {
   write_file(case_file, fmt::format(R"(run {{ end_time: {} output_dir: "{}" }}
 coupling {{
-  endpoint: "ipc://{}/c.ipc"
+  endpoint: "{}"
   heartbeat_interval_s: {}
   peer_timeout_s: {}
   startup_timeout_s: {}
   {}
 }}
 )",
-                                    spec.end_time, dir.string(), dir.string(), spec.heartbeat_interval_s,
+                                    spec.end_time, dir.string(),
+                                    spec.endpoint.empty() ? "ipc://" + dir.string() + "/c.ipc" : spec.endpoint,
+                                    spec.heartbeat_interval_s,
                                     spec.peer_timeout_s, spec.startup_timeout_s, spec.coupling));
   const std::vector<std::string> common = {"--case", case_file.string(), "--output", dir.string()};
   auto with = [&](std::vector<std::string> argv, const std::vector<std::string>& extra) {

@@ -29,6 +29,7 @@ struct RunSpec {
   std::string solid = "standin_solid_plate";
   std::vector<std::string> solid_args;
   bool start_fluid = true;
+  std::string endpoint;             // empty: ipc://<folder>/c.ipc
 };
 
 class CoupledRun {

@@ -22,13 +22,15 @@ using coupling::kExitProtocolError;
 
 // Heartbeat 0.1 s, peer timeout 1 s: a lost peer must be noticed within about a second.
 RunSpec long_run(const std::string& name) {
-  return RunSpec{.name = name,
-                 .end_time = 100.0,  // never reached: the fault comes first
-                 .coupling = "window_size: 1e-3",
-                 .heartbeat_interval_s = 0.1,
-                 .peer_timeout_s = 1.0,
-                 .fluid_args = {"--step-seconds", "0.02"},
-                 .solid_args = {"--step-seconds", "0.01"}};
+  RunSpec spec;
+  spec.name = name;
+  spec.end_time = 100.0;  // never reached: the fault comes first
+  spec.coupling = "window_size: 1e-3";
+  spec.heartbeat_interval_s = 0.1;
+  spec.peer_timeout_s = 1.0;
+  spec.fluid_args = {"--step-seconds", "0.02"};
+  spec.solid_args = {"--step-seconds", "0.01"};
+  return spec;
 }
 
 // Both windows-in-progress and the series file exist once the run is under way.
@@ -60,16 +62,16 @@ TEST(CouplerFaults, KilledFluidStopsCouplerAndSolidNamingTheFluid) {
   CoupledRun run(long_run("kill-fluid"));
   wait_until_running(run);
   run.fluid->send_signal(SIGKILL);
-  expect_exit(*run.coupler, kExitPeerLost, 4s, "participant 'fluid'", "coupler");
-  expect_exit(*run.solid, kExitAborted, 4s, "participant 'fluid'", "solid");
+  expect_exit(*run.coupler, kExitPeerLost, 6s, "participant 'fluid'", "coupler");
+  expect_exit(*run.solid, kExitAborted, 6s, "participant 'fluid'", "solid");
 }
 
 TEST(CouplerFaults, FrozenFluidIsDeclaredSilentAndEverythingElseStops) {
   CoupledRun run(long_run("stop-fluid"));
   wait_until_running(run);
   run.fluid->send_signal(SIGSTOP);
-  expect_exit(*run.coupler, kExitPeerLost, 4s, "participant 'fluid' has been silent", "coupler");
-  expect_exit(*run.solid, kExitAborted, 4s, "participant 'fluid' has been silent", "solid");
+  expect_exit(*run.coupler, kExitPeerLost, 6s, "participant 'fluid' has been silent", "coupler");
+  expect_exit(*run.solid, kExitAborted, 6s, "participant 'fluid' has been silent", "solid");
   // The frozen process is the launcher's to kill (scripts/run_case.py does); here the harness does.
 }
 
@@ -77,8 +79,8 @@ TEST(CouplerFaults, FrozenSolidDuringTheFluidsStepIsNoticed) {
   CoupledRun run(long_run("stop-solid"));
   wait_until_running(run);
   run.solid->send_signal(SIGSTOP);
-  expect_exit(*run.coupler, kExitPeerLost, 4s, "participant 'solid'", "coupler");
-  expect_exit(*run.fluid, kExitAborted, 4s, "participant 'solid'", "fluid");
+  expect_exit(*run.coupler, kExitPeerLost, 6s, "participant 'solid'", "coupler");
+  expect_exit(*run.fluid, kExitAborted, 6s, "participant 'solid'", "fluid");
 }
 
 TEST(CouplerFaults, KilledCouplerStopsBothParticipantsEvenMidStep) {
@@ -87,8 +89,8 @@ TEST(CouplerFaults, KilledCouplerStopsBothParticipantsEvenMidStep) {
   CoupledRun run(spec);
   wait_until_running(run);
   run.coupler->send_signal(SIGKILL);
-  expect_exit(*run.fluid, kExitPeerLost, 4s, "the coupler has been silent", "fluid");
-  expect_exit(*run.solid, kExitPeerLost, 4s, "the coupler has been silent", "solid");
+  expect_exit(*run.fluid, kExitPeerLost, 6s, "the coupler has been silent", "fluid");
+  expect_exit(*run.solid, kExitPeerLost, 6s, "the coupler has been silent", "solid");
 }
 
 TEST(CouplerFaults, ParticipantExitingSilentlyIsNamed) {
@@ -96,8 +98,8 @@ TEST(CouplerFaults, ParticipantExitingSilentlyIsNamed) {
   spec.solid_args = {"--exit-at-window", "5"};
   CoupledRun run(spec);
   expect_exit(*run.solid, 7, 20s, "", "solid");
-  expect_exit(*run.coupler, kExitPeerLost, 4s, "participant 'solid'", "coupler");
-  expect_exit(*run.fluid, kExitAborted, 4s, "participant 'solid'", "fluid");
+  expect_exit(*run.coupler, kExitPeerLost, 6s, "participant 'solid'", "coupler");
+  expect_exit(*run.fluid, kExitAborted, 6s, "participant 'solid'", "fluid");
 }
 
 TEST(CouplerFaults, MalformedMessageEndsTheRunNamingTheSender) {
@@ -106,8 +108,8 @@ TEST(CouplerFaults, MalformedMessageEndsTheRunNamingTheSender) {
   spec.fluid_args = {"--misbehave", "malformed"};
   CoupledRun run(spec);
   expect_exit(*run.coupler, kExitProtocolError, 20s, "participant 'fluid' sent a malformed message", "coupler");
-  expect_exit(*run.solid, kExitAborted, 4s, "malformed", "solid");
-  expect_exit(*run.fluid, kExitAborted, 4s, "the coupler aborted the run", "fluid");
+  expect_exit(*run.solid, kExitAborted, 6s, "malformed", "solid");
+  expect_exit(*run.fluid, kExitAborted, 6s, "the coupler aborted the run", "fluid");
 }
 
 TEST(CouplerFaults, ProtocolVersionMismatchNamesBothVersions) {
@@ -117,7 +119,7 @@ TEST(CouplerFaults, ProtocolVersionMismatchNamesBothVersions) {
   CoupledRun run(spec);
   expect_exit(*run.coupler, kExitProtocolError, 20s,
               "participant 'fluid' speaks coupling protocol version 99, the coupler speaks version 1", "coupler");
-  expect_exit(*run.solid, kExitAborted, 4s, "version 99", "solid");
+  expect_exit(*run.solid, kExitAborted, 6s, "version 99", "solid");
 }
 
 TEST(CouplerFaults, NanArrivingAtTheCouplerIsLocatedByParticipantFieldAndIndex) {
@@ -128,7 +130,7 @@ TEST(CouplerFaults, NanArrivingAtTheCouplerIsLocatedByParticipantFieldAndIndex) 
   expect_exit(*run.coupler, kExitAborted, 20s,
               "participant 'fluid': non-finite value in interface_point_cloud.positions at index 10 (point 3, component y)",
               "coupler");
-  expect_exit(*run.solid, kExitAborted, 4s, "index 10", "solid");
+  expect_exit(*run.solid, kExitAborted, 6s, "index 10", "solid");
 }
 
 TEST(CouplerFaults, NanLeavingAParticipantIsRefusedBeforeItIsSent) {
@@ -138,8 +140,8 @@ TEST(CouplerFaults, NanLeavingAParticipantIsRefusedBeforeItIsSent) {
   expect_exit(*run.fluid, kExitAborted, 20s,
               "participant 'fluid': non-finite value in window_done.loads.forces at index 7 (point 2, component y)",
               "fluid");
-  expect_exit(*run.coupler, kExitAborted, 4s, "participant 'fluid' aborted the run", "coupler");
-  expect_exit(*run.solid, kExitAborted, 4s, "window_done.loads.forces at index 7", "solid");
+  expect_exit(*run.coupler, kExitAborted, 6s, "participant 'fluid' aborted the run", "coupler");
+  expect_exit(*run.solid, kExitAborted, 6s, "window_done.loads.forces at index 7", "solid");
 }
 
 TEST(CouplerFaults, MessageOutOfOrderIsAProtocolError) {
@@ -157,7 +159,7 @@ TEST(CouplerFaults, ParticipantThatNeverConnectsIsReportedAfterTheStartupTimeout
   spec.startup_timeout_s = 1.0;
   CoupledRun run(spec);
   expect_exit(*run.coupler, kExitPeerLost, 10s, "participant 'fluid' did not connect", "coupler");
-  expect_exit(*run.solid, kExitAborted, 4s, "did not connect", "solid");
+  expect_exit(*run.solid, kExitAborted, 6s, "did not connect", "solid");
 }
 
 TEST(CouplerFaults, LongStepIsNotAHang) {

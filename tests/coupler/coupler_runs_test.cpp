@@ -29,6 +29,18 @@ Plate advance(Plate s, double force, double dt) {
   return {z_eq + (s.z - z_eq) * c + s.v / kOmega * sn, -(s.z - z_eq) * kOmega * sn + s.v * c};
 }
 
+RunSpec plate_run(const std::string& name, double end_time, const std::string& coupling, const std::string& fluid,
+                  std::vector<std::string> fluid_args) {
+  RunSpec spec;
+  spec.name = name;
+  spec.end_time = end_time;
+  spec.coupling = coupling;
+  spec.fluid = fluid;
+  spec.fluid_args = std::move(fluid_args);
+  spec.solid_args = kPlateArgs;
+  return spec;
+}
+
 void expect_all_ended_ok(CoupledRun& run) {
   const auto codes = run.wait_all(std::chrono::seconds(60));
   for (const char* role : {"coupler", "solid", "fluid"}) {
@@ -40,8 +52,7 @@ void expect_all_ended_ok(CoupledRun& run) {
 }
 
 TEST(CoupledRun, SerialExplicitPlateUnderPressureMatchesExactSolutionAndConservesForceAndPower) {
-  CoupledRun run({.name = "serial", .end_time = 0.05, .coupling = "window_size: 1e-3", .fluid_args = {"--pressure", "100"},
-                  .solid_args = kPlateArgs});
+  CoupledRun run(plate_run("serial", 0.05, "window_size: 1e-3", "standin_fluid_pressure", {"--pressure", "100"}));
   expect_all_ended_ok(run);
   const double force = kPressure * kArea;
   const double exact = force / kStiffness * (1.0 - std::cos(kOmega * 0.05));
@@ -63,9 +74,18 @@ TEST(CoupledRun, SerialExplicitPlateUnderPressureMatchesExactSolutionAndConserve
   EXPECT_GT(std::abs(fluid_power[10]), 1e-5);  // the plate moves: the power check is not 0 = 0
 }
 
+TEST(CoupledRun, TcpEndpointGivesTheSameAnswer) {
+  RunSpec spec = plate_run("tcp", 0.05, "window_size: 1e-3", "standin_fluid_pressure", {"--pressure", "100"});
+  spec.endpoint = "tcp://127.0.0.1:47391";
+  CoupledRun run(spec);
+  expect_all_ended_ok(run);
+  const double exact = kPressure * kArea / kStiffness * (1.0 - std::cos(kOmega * 0.05));
+  EXPECT_NEAR(final_plate_z(run.solid->log_text()), exact, 1e-9 * exact);
+}
+
 TEST(CoupledRun, ParallelExplicitLagsTheLoadsByOneWindow) {
-  CoupledRun run({.name = "parallel", .end_time = 0.05, .coupling = "scheme: PARALLEL_EXPLICIT window_size: 1e-3",
-                  .fluid_args = {"--pressure", "100"}, .solid_args = kPlateArgs});
+  CoupledRun run(plate_run("parallel", 0.05, "scheme: PARALLEL_EXPLICIT window_size: 1e-3", "standin_fluid_pressure",
+                           {"--pressure", "100"}));
   expect_all_ended_ok(run);
   // The solid sees no load in the first window, then p A: z(T) = pA/k (1 - cos w (T - dt)).
   const double exact = kPressure * kArea / kStiffness * (1.0 - std::cos(kOmega * (0.05 - 1e-3)));
@@ -76,8 +96,8 @@ TEST(CoupledRun, SwappedFluidDamperReproducesItsExplicitRecurrence) {
   // Same coupler, same solid, another fluid program: f = (p - c v_z) per unit area, with the
   // window-start velocity in the serial explicit scheme.
   const double c = 2000.0, dt = 1e-3;
-  CoupledRun run({.name = "swap", .end_time = 0.05, .coupling = "window_size: 1e-3", .fluid = "standin_fluid_damper",
-                  .fluid_args = {"--pressure", "100", "--damping", "2000"}, .solid_args = kPlateArgs});
+  CoupledRun run(plate_run("swap", 0.05, "window_size: 1e-3", "standin_fluid_damper",
+                           {"--pressure", "100", "--damping", "2000"}));
   expect_all_ended_ok(run);
   Plate plate;
   for (int n = 0; n < 50; ++n) plate = advance(plate, (kPressure - c * plate.v) * kArea, dt);
@@ -89,13 +109,10 @@ TEST(CoupledRun, SwappedFluidDamperReproducesItsExplicitRecurrence) {
 // F = (p - c (z1 - z0)/dt) A is linear, so the converged answer is known in closed form.
 void implicit_damper_converges(const std::string& acceleration, int max_mean_iterations_x10) {
   const double c = 5000.0, dt = 1e-3;
-  CoupledRun run({.name = "implicit-" + acceleration,
-                  .end_time = 0.02,
-                  .coupling = "scheme: SERIAL_IMPLICIT acceleration: " + acceleration +
-                              " relative_tolerance: 1e-10 max_iterations: 60 relaxation_factor: 0.5 window_size: 1e-3",
-                  .fluid = "standin_fluid_damper",
-                  .fluid_args = {"--pressure", "100", "--damping", "5000"},
-                  .solid_args = kPlateArgs});
+  CoupledRun run(plate_run("implicit-" + acceleration, 0.02,
+                           "scheme: SERIAL_IMPLICIT acceleration: " + acceleration +
+                               " relative_tolerance: 1e-10 max_iterations: 60 relaxation_factor: 0.5 window_size: 1e-3",
+                           "standin_fluid_damper", {"--pressure", "100", "--damping", "5000"}));
   expect_all_ended_ok(run);
   Plate plate;
   const double cosine = std::cos(kOmega * dt), sine = std::sin(kOmega * dt), b = (1.0 - cosine) / kStiffness;
@@ -125,8 +142,9 @@ TEST(CoupledRun, SerialImplicitAitkenConvergesToTheFixedPoint) { implicit_damper
 TEST(CoupledRun, SerialImplicitIqnIlsConvergesToTheFixedPoint) { implicit_damper_converges("IQN_ILS", 35); }
 
 TEST(CoupledRun, WindowIsTheSmallestOfCaseAndProposalsAndLandsOnTheEndTime) {
-  CoupledRun run({.name = "window", .end_time = 0.0101, .coupling = "window_size: 1e-3",
-                  .fluid_args = {"--propose-window", "4e-4"}, .solid_args = {"--propose-window", "6e-4"}});
+  RunSpec spec = plate_run("window", 0.0101, "window_size: 1e-3", "standin_fluid_pressure", {"--propose-window", "4e-4"});
+  spec.solid_args = {"--propose-window", "6e-4"};
+  CoupledRun run(spec);
   expect_all_ended_ok(run);
   const auto size = read_series(run.dir / "coupling_series.h5", "window_size");
   const auto time = read_series(run.dir / "coupling_series.h5", "time");

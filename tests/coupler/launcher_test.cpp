@@ -103,7 +103,15 @@ TEST(Launcher, FrozenParticipantEndsTheRunAndIsStopped) {
     std::this_thread::sleep_for(50ms);
   }
   ASSERT_EQ(fluid.size(), 1u);
-  std::this_thread::sleep_for(500ms);
+  // Freeze it mid-run (frozen before its first word it would count as not yet started).
+  auto coupler_log = [&] {
+    std::ifstream in(output / "coupler.log");
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  while (coupler_log().find("mapped") == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(20ms);
+  }
+  std::this_thread::sleep_for(300ms);
   ::kill(fluid[0], SIGSTOP);
   const auto code = launcher->wait_for_exit(15s);
   ASSERT_TRUE(code.has_value()) << launcher->log_text();

@@ -40,8 +40,15 @@ struct Outcome {
 
 Outcome run(const std::string& name, double end_time, const std::string& coupling, std::vector<std::string> fluid_args,
             std::vector<std::string> solid_args) {
-  CoupledRun run({.name = name, .end_time = end_time, .coupling = coupling, .fluid = "standin_model_fluid",
-                  .fluid_args = std::move(fluid_args), .solid = "standin_model_solid", .solid_args = std::move(solid_args)});
+  RunSpec spec;
+  spec.name = name;
+  spec.end_time = end_time;
+  spec.coupling = coupling;
+  spec.fluid = "standin_model_fluid";
+  spec.fluid_args = std::move(fluid_args);
+  spec.solid = "standin_model_solid";
+  spec.solid_args = std::move(solid_args);
+  CoupledRun run(spec);
   Outcome outcome;
   outcome.codes = run.wait_all(120s);
   outcome.solid_log = run.solid->log_text();

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <array>
 #include <optional>
 
@@ -60,13 +61,11 @@ void finish_run(MessageChannel& channel, double end_time) {
   }
 }
 
-void abort_participants(MessageChannel& channel, const std::string& reason) {
-  for (const char* peer : {kFluid, kSolid}) {
-    protocol::Envelope abort;
-    abort.mutable_abort()->set_reason(reason);
-    abort.mutable_abort()->set_origin(protocol::ROLE_COUPLER);
-    (void)channel.try_send(peer, std::move(abort));
-  }
+// A participant that has not connected yet gets this long to show up and hear the abort.
+constexpr double kAbortGraceSeconds = 3.0;
+
+void abort_participants(MessageChannel& channel, const std::string& reason, const CouplerSettings& settings) {
+  channel.abort_all(reason, std::chrono::duration<double>(std::min(kAbortGraceSeconds, settings.liveness.startup_timeout.count())));
 }
 
 }  // namespace
@@ -99,11 +98,11 @@ int run_coupler(const CouplerSettings& settings) {
                  settings.series_file.string());
   } catch (const coupling::TransportError& error) {
     spdlog::error("coupler: {}; stopping the run", error.what());
-    abort_participants(*channel, error.what());
+    abort_participants(*channel, error.what(), settings);
     exit_code = error.exit_code();
   } catch (const std::exception& error) {
     spdlog::error("coupler: {}; stopping the run", error.what());
-    abort_participants(*channel, fmt::format("the coupler failed: {}", error.what()));
+    abort_participants(*channel, fmt::format("the coupler failed: {}", error.what()), settings);
     exit_code = coupling::kExitBadInput;
   }
   channel->close(kGoodbyeLinger);

@@ -164,6 +164,36 @@ void MessageChannel::send_raw_for_testing(const std::string& peer, const std::st
   socket_.send(zmq::buffer(bytes), zmq::send_flags::none);
 }
 
+void MessageChannel::abort_all(const std::string& reason, std::chrono::duration<double> grace) noexcept {
+  try {
+    std::lock_guard lock(mutex_);
+    if (closed_) return;
+    std::map<std::string, bool> told;
+    const auto give_up = Clock::now() + duration_cast<Clock::duration>(grace);
+    for (;;) {
+      bool waiting_for_someone = false;
+      for (const auto& [name, state] : peers_) {
+        if (state.last_heard && !told[name]) {
+          protocol::Envelope abort;
+          abort.mutable_abort()->set_reason(reason);
+          abort.mutable_abort()->set_origin(is_router_ ? protocol::ROLE_COUPLER : protocol::ROLE_UNSPECIFIED);
+          try {
+            send_locked(name, abort, false);
+          } catch (const TransportError&) {
+            // gone already
+          }
+          told[name] = true;
+        }
+        if (!state.last_heard && state.watched) waiting_for_someone = true;
+      }
+      if (!waiting_for_someone || Clock::now() >= give_up) return;
+      pump(milliseconds(20));
+    }
+  } catch (...) {
+    // Best effort: the run is ending anyway.
+  }
+}
+
 bool MessageChannel::try_send(const std::string& peer, protocol::Envelope envelope) noexcept {
   try {
     std::lock_guard lock(mutex_);
@@ -207,7 +237,7 @@ std::optional<Incoming> MessageChannel::receive_matching(const std::string* peer
     }
     const auto now = Clock::now();
     if (give_up && now >= *give_up) return std::nullopt;
-    check_peers(now);
+    if (!confirm_peers_alive()) continue;  // it drained new messages: look at them first
     rethrow_fault();
     auto wake = next_wake(now);
     if (give_up) wake = std::min(wake, *give_up);
@@ -219,6 +249,7 @@ void MessageChannel::pump(milliseconds wait) {
   send_heartbeats_if_due(Clock::now());
   zmq::pollitem_t item{socket_.handle(), 0, ZMQ_POLLIN, 0};
   zmq::poll(&item, 1, wait);
+  send_heartbeats_if_due(Clock::now());  // due during a long poll; the drain below follows it
   for (;;) {
     zmq::message_t first;
     if (!socket_.recv(first, zmq::recv_flags::dontwait)) break;
@@ -241,7 +272,8 @@ void MessageChannel::pump(milliseconds wait) {
     }
     accept(peer, payload);
   }
-  send_heartbeats_if_due(Clock::now());
+  // No heartbeat after the drain: a connection found gone while sending must be followed by a
+  // drain, so that a goodbye it sent just before closing is read before it counts as lost.
 }
 
 void MessageChannel::accept(const std::string& peer, const zmq::message_t& payload) {
@@ -263,37 +295,51 @@ void MessageChannel::send_heartbeats_if_due(Clock::time_point now) {
   if (now < next_heartbeat_) return;
   next_heartbeat_ = now + duration_cast<Clock::duration>(liveness_.heartbeat_interval);
   const double wall = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-  for (const auto& [name, state] : peers_) {
+  for (auto& [name, state] : peers_) {
     // A ROUTER can only reach peers it heard and stops at their goodbye; a DEALER keeps its
     // coupler informed until it closes (it may write output for a while after Finish).
-    if (is_router_ && (!state.watched || !state.last_heard)) continue;
+    if (is_router_ && (!state.watched || !state.last_heard || state.disconnected)) continue;
     protocol::Envelope heartbeat;
     heartbeat.mutable_heartbeat()->set_wall_time(wall);
     try {
       send_locked(name, heartbeat, false);
-    } catch (const PeerLost&) {
-      record_fault(std::current_exception());
+    } catch (const PeerLost& lost) {
+      state.disconnected = lost.what();
     }
   }
 }
 
-void MessageChannel::check_peers(Clock::time_point now) {
+bool MessageChannel::confirm_peers_alive() {
+  if (!find_lost_peer(Clock::now())) return true;
+  // Judge only after listening: if this process itself was descheduled or busy, the peer's
+  // heartbeats may be waiting unread. A live peer speaks within one heartbeat interval.
+  const std::size_t before = inbox_.size();
+  pump(std::clamp(duration_cast<milliseconds>(liveness_.heartbeat_interval), milliseconds(10), kMaxPollSlice));
+  if (inbox_.size() != before) return false;
+  if (auto lost = find_lost_peer(Clock::now())) record_fault(lost);
+  return true;
+}
+
+std::exception_ptr MessageChannel::find_lost_peer(Clock::time_point now) const {
   for (const auto& [name, state] : peers_) {
     if (!state.watched) continue;
-    if (state.last_heard) {
+    if (state.disconnected) {
+      return std::make_exception_ptr(PeerLost(*state.disconnected));
+    } else if (state.last_heard) {
       const std::chrono::duration<double> silence = now - *state.last_heard;
       if (silence > liveness_.peer_timeout) {
-        record_fault(std::make_exception_ptr(PeerLost(fmt::format(
+        return std::make_exception_ptr(PeerLost(fmt::format(
             "{} has been silent for {:.1f} s (peer timeout {} s, heartbeat every {} s): it died or is frozen",
             describe(name), silence.count(), seconds(liveness_.peer_timeout),
-            seconds(liveness_.heartbeat_interval)))));
+            seconds(liveness_.heartbeat_interval))));
       }
     } else if (now > state.first_contact_deadline) {
-      record_fault(std::make_exception_ptr(PeerLost(fmt::format(
+      return std::make_exception_ptr(PeerLost(fmt::format(
           "{} did not connect to {} within the startup timeout of {} s", describe(name), endpoint_,
-          seconds(liveness_.startup_timeout)))));
+          seconds(liveness_.startup_timeout))));
     }
   }
+  return nullptr;
 }
 
 void MessageChannel::record_fault(std::exception_ptr fault) {
@@ -330,7 +376,7 @@ void MessageChannel::heartbeat_loop() {
     std::unique_lock lock(mutex_, std::try_to_lock);
     if (!lock.owns_lock() || closed_) continue;  // the owner is inside a call and pumps itself
     pump(milliseconds(0));
-    check_peers(Clock::now());
+    (void)confirm_peers_alive();
     if (fault_ && fault_handler_) {
       const auto fault = fault_;
       const auto handler = fault_handler_;

@@ -87,6 +87,11 @@ class MessageChannel {
   // As receive_any but returns nothing after `wait` without a message (faults still throw).
   std::optional<Incoming> poll_any(std::chrono::duration<double> wait);
 
+  // Tells every peer the run is over: an Abort (with `reason`) to each peer heard so far, then,
+  // for up to `grace`, to each expected peer that speaks for the first time (a participant that
+  // starts late must not wait out its startup timeout for a coupler that is gone). Never throws.
+  void abort_all(const std::string& reason, std::chrono::duration<double> grace) noexcept;
+
   // Stops heartbeats and closes, allowing pending messages up to `linger` to leave.
   void close(std::chrono::milliseconds linger = std::chrono::milliseconds(0));
 
@@ -101,6 +106,9 @@ class MessageChannel {
     std::optional<Clock::time_point> last_heard;
     Clock::time_point first_contact_deadline;
     bool watched = true;
+    // A heartbeat could not be routed: the connection is gone. A fault only if no goodbye
+    // (Finish) was still queued from it, which the next pump tells.
+    std::optional<std::string> disconnected;
   };
 
   MessageChannel(zmq::socket_type type, std::string endpoint, std::string local_name,
@@ -110,7 +118,11 @@ class MessageChannel {
   void accept(const std::string& peer, const zmq::message_t& payload);
   void send_heartbeats_if_due(Clock::time_point now);
   void send_locked(const std::string& peer, protocol::Envelope& envelope, bool may_wait);
-  void check_peers(Clock::time_point now);
+  // The first watched peer that is lost (silent too long, never connected, disconnected), if any.
+  [[nodiscard]] std::exception_ptr find_lost_peer(Clock::time_point now) const;
+  // Records a loss only if it survives one more heartbeat interval of listening; returns false
+  // when that listening brought new messages (the caller should look at them first).
+  bool confirm_peers_alive();
   void record_fault(std::exception_ptr fault);
   void rethrow_fault() const;
   [[nodiscard]] Clock::time_point next_wake(Clock::time_point now) const;

@@ -58,7 +58,7 @@ struct SolverOptions {
   double contact_stiffness_factor = 0.1;  // penalty k = factor * m * omega_max^2 per node
   double time_step_safety = 0.8;        // fraction of the estimated critical step
   double mass_damping_per_s = 0.0;      // alpha of the damping force alpha m v (off when 0)
-  int time_step_update_interval = 1;    // re-estimate the stable step every this many steps
+  int time_step_update_interval = 10;   // re-estimate the stable step every this many steps
   double max_time_step = 1e-4;          // upper bound on dt (s)
 };
 

@@ -17,10 +17,10 @@ using namespace valvefsi::fluid::thin_wall;
 
 int main(int argc, char** argv) {
   CLI::App app{"2D thin-wall scenes: two_levels, gap, plate"};
-  std::string scene = "two_levels", output;
+  std::string scene = "two_levels", output, marker_output;
   double dp = 0.025, end_time = 1.0, gap = 0.1, shifting = 0.0, sample_interval = 1e-3;
   double lattice_ratio = 0.5, background = 0.0;
-  bool half_plane = false;
+  bool half_plane = false, opposite_beyond_edge = false;
   OscillatingPlate plate;
   app.add_option("--scene", scene, "two_levels | gap | plate")->check(CLI::IsMember({"two_levels", "gap", "plate"}));
   app.add_option("--dp", dp, "particle spacing (m)");
@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   app.add_option("--shifting", shifting, "particle shifting coefficient A (0: off)");
   app.add_option("--lattice-ratio", lattice_ratio, "virtual lattice spacing / dp");
   app.add_flag("--half-plane", half_plane, "count the whole half-plane lattice, not only the wall's shadow");
+  app.add_flag("--opposite-beyond-edge", opposite_beyond_edge, "virtual points beyond a free end carry the other side's state");
   app.add_option("--plate-width", plate.plate_width, "plate width b (m)");
   app.add_option("--amplitude", plate.amplitude, "plate amplitude A (m)");
   app.add_option("--period", plate.period, "plate period (s)");
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
   app.add_option("--background", background, "background pressure (Pa)");
   app.add_option("--sample", sample_interval, "output interval (s)");
   app.add_option("--output", output, "CSV file of the time series");
+  app.add_option("--marker-output", marker_output, "CSV file of every marker's force (x) over time");
   CLI11_PARSE(app, argc, argv);
 
   ThinWallCase2D c = scene == "plate" ? oscillating_plate_box(dp, plate)
@@ -46,12 +48,20 @@ int main(int argc, char** argv) {
   c.fluid.background_pressure = background;
   c.wall_settings.virtual_spacing_ratio = lattice_ratio;
   c.wall_settings.shadow_only = !half_plane;
+  c.wall_settings.opposite_state_beyond_edge = opposite_beyond_edge;
   const auto start = std::chrono::steady_clock::now();
   ThinWallFlow2D flow(std::move(c));
   std::ofstream csv;
   if (!output.empty()) {
     csv.open(output);
     csv << "time,force_x,force_y,wall_x,wall_vx,left_count,right_count,corrections,leaks,rejected_shifts,max_speed\n";
+  }
+  std::ofstream markers_csv;
+  if (!marker_output.empty()) {
+    markers_csv.open(marker_output);
+    markers_csv << "time";
+    for (const auto& m : flow.wall_model().markers().markers()) markers_csv << ",s" << m.arc_length;
+    markers_csv << '\n';
   }
   double next = 0;
   while (flow.time() < end_time * (1 - 1e-12)) {
@@ -70,6 +80,11 @@ int main(int argc, char** argv) {
       const auto& k = flow.wall_model().counters();
       if (csv) csv << flow.time() << ',' << flow.wall_force()[0] << ',' << flow.wall_force()[1] << ',' << xw << ',' << flow.wall_model().wall().velocity[0][0] << ',' << left << ','
                    << right << ',' << k.corrections << ',' << k.leaks << ',' << k.rejected_shifts << ',' << vmax << '\n';
+      if (markers_csv) {
+        markers_csv << flow.time();
+        for (const auto& m : flow.wall_model().markers().markers()) markers_csv << ',' << m.force[0];
+        markers_csv << '\n';
+      }
       if (!std::isfinite(vmax) || vmax > 100) {
         spdlog::error("blow-up at t = {:.4f} s", flow.time());
         return 1;

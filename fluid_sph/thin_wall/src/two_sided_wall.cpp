@@ -213,8 +213,15 @@ void TwoSidedWall::add_wall_rates(Particles<2>& p) {
           // point, extrapolated hydrostatically (with the wall's acceleration) to it.
           const Vec2 q = wall_.point(seg, tw);
           const MarkerWeights mw = markers_.weights_at(markers_.arc_length(seg, tw));
-          const SideState& s0 = markers_[mw.first].side[k_side];
-          const SideState& s1 = markers_[mw.second].side[k_side];
+          int k_state = k_side;
+          if (settings_.opposite_state_beyond_edge) {
+            const Vec2 e{wall_.position[seg + 1][0] - wall_.position[seg][0], wall_.position[seg + 1][1] - wall_.position[seg][1]};
+            const double along = ((xv[0] - wall_.position[seg][0]) * e[0] + (xv[1] - wall_.position[seg][1]) * e[1]) / dot(e, e);
+            const bool beyond = (seg == 0 && along < 0.0) || (seg + 1 == wall_.segment_count() && along > 1.0);
+            if (beyond) k_state = 1 - k_side;
+          }
+          const SideState& s0 = markers_[mw.first].side[k_state];
+          const SideState& s1 = markers_[mw.second].side[k_state];
           const Vec2 vw = wall_.velocity_at(seg, tw);
           const Vec2 aw = wall_.acceleration_at(seg, tw);
           double p_v = mw.w0 * s0.pressure + mw.w1 * s1.pressure;

@@ -34,6 +34,11 @@ struct ThinWallSettings {
   // wall) count. If false, the whole half-plane lattice behind the closest point counts
   // (a measured alternative; it over-fills the kernel beyond a free edge).
   bool shadow_only = true;
+  // Virtual points in the shadow but beyond a free end (their projection on the crossed
+  // segment's line lies past the end node) stand where the real fluid is the other side's:
+  // give them the other side's state at the end instead of the particle's own side's.
+  // (A measured alternative for the free edge; docs/thin-leaflet.md.)
+  bool opposite_state_beyond_edge = false;
 };
 
 // What the model knows of one particle after classify (sorted index).

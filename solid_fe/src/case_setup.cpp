@@ -93,6 +93,7 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   options.density = solid.density();
   options.thickness_points = solid.thickness_points();
   options.clamp_fixed_edges = !solid.hinged_fixed_edges();
+  for (const auto& [name, plane] : mesh.symmetry_planes) options.symmetry_planes.push_back(plane);
   std::vector<std::string> fixed_sets(solid.fixed_node_sets().begin(), solid.fixed_node_sets().end());
   if (fixed_sets.empty()) fixed_sets.push_back("attachment");
   std::set<std::int64_t> fixed;

@@ -70,6 +70,18 @@ ShellModel build_shell_model(const Mesh& mesh, const ShellModelOptions& options,
     model.fixed[static_cast<std::size_t>(n)] = 1;
   }
 
+  for (const Plane& plane : options.symmetry_planes) model.mirror_planes.push_back({plane.point, plane.normal.normalized()});
+  const double model_size = (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
+  const auto plane_of_edge = [&](std::int64_t a, std::int64_t b) -> int {
+    for (std::size_t k = 0; k < model.mirror_planes.size(); ++k) {
+      const Plane& plane = model.mirror_planes[k];
+      const double da = (mesh.nodes.col(a) - plane.point).dot(plane.normal);
+      const double db = (mesh.nodes.col(b) - plane.point).dot(plane.normal);
+      if (std::abs(da) <= 1e-6 * model_size && std::abs(db) <= 1e-6 * model_size) return static_cast<int>(k);
+    }
+    return -1;
+  };
+
   // Directed edge (a -> b) to (triangle, local edge index) for neighbour search.
   std::map<std::pair<std::int64_t, std::int64_t>, std::pair<std::int64_t, int>> directed;
   const std::int64_t num_triangles = mesh.num_triangles();
@@ -167,6 +179,23 @@ ShellModel build_shell_model(const Mesh& mesh, const ShellModelOptions& options,
           const Eigen::Vector2d g_own = linear_gradient({p[ia], p[ib], p[i]}, {w(p[ia]), w(p[ib]), w(p[i])});
           rows(i, J) = -g_own.dot(outward);
         }
+      } else if (const int k = plane_of_edge(a, b); k >= 0) {
+        el.edge_kind[i] = EdgeKind::mirror;
+        el.mirror_plane[i] = static_cast<std::int8_t>(k);
+        // The mirror image of this triangle, unfolded: its vertex reflected across the edge line.
+        const Eigen::Vector2d foot = p[ia] + (p[i] - p[ia]).dot(edge2) * edge2;
+        const Eigen::Vector2d po = 2.0 * foot - p[i];
+        for (int J = 0; J < 3; ++J) {
+          const auto w = [&](const Eigen::Vector2d& q) { return 0.5 * (q - midpoint).dot(unit_kappa[J] * (q - midpoint)); };
+          const Eigen::Vector2d g_own = linear_gradient({p[ia], p[ib], p[i]}, {w(p[ia]), w(p[ib]), w(p[i])});
+          const Eigen::Vector2d g_other = linear_gradient({p[ia], p[ib], po}, {w(p[ia]), w(p[ib]), w(po)});
+          rows(i, J) = (g_other - g_own).dot(outward);
+        }
+        const Plane& plane = model.mirror_planes[static_cast<std::size_t>(k)];
+        const Eigen::Vector3d Xa = node(mesh, a), Xb = node(mesh, b);
+        const Eigen::Vector3d ghost = X[i] - 2.0 * (X[i] - plane.point).dot(plane.normal) * plane.normal;
+        el.reference_fold_angle[i] =
+            fold_angle(hinge_side(Xa, Xb, X[i], false), hinge_side(Xa, Xb, ghost, true), Xa, Xb);
       } else {
         el.edge_kind[i] = EdgeKind::free;
         // Zero normal curvature across a free edge: t.kappa.t = 0.

@@ -34,7 +34,7 @@ struct ElementState {
   std::array<HingeSide, 3> neighbour_side;
 };
 
-inline ElementState element_kinematics(const ShellElement& el, const Eigen::Matrix3Xd& x) {
+inline ElementState element_kinematics(const ShellModel& model, const ShellElement& el, const Eigen::Matrix3Xd& x) {
   ElementState s;
   s.deformation_gradient.setZero();
   for (int a = 0; a < 3; ++a) {
@@ -48,6 +48,16 @@ inline ElementState element_kinematics(const ShellElement& el, const Eigen::Matr
       case EdgeKind::interior: {
         s.own_side[i] = hinge_side(xa, xb, x.col(el.nodes[i]), false);
         s.neighbour_side[i] = hinge_side(xa, xb, x.col(el.opposite[i]), true);
+        s.fold_angle_change(i) = fold_angle(s.own_side[i], s.neighbour_side[i], xa, xb) -
+                                 el.reference_fold_angle[i];
+        break;
+      }
+      case EdgeKind::mirror: {
+        const Plane& plane = model.mirror_planes[static_cast<std::size_t>(el.mirror_plane[i])];
+        const Eigen::Vector3d xo = x.col(el.nodes[i]);
+        const Eigen::Vector3d ghost = xo - 2.0 * (xo - plane.point).dot(plane.normal) * plane.normal;
+        s.own_side[i] = hinge_side(xa, xb, xo, false);
+        s.neighbour_side[i] = hinge_side(xa, xb, ghost, true);
         s.fold_angle_change(i) = fold_angle(s.own_side[i], s.neighbour_side[i], xa, xb) -
                                  el.reference_fold_angle[i];
         break;
@@ -105,7 +115,7 @@ template <class Law>
 ElementResult add_element_internal_force(const ShellModel& model, const ShellElement& el, const Law& law,
                                          const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& forces,
                                          bool estimate_step) {
-  const ElementState s = element_kinematics(el, x);
+  const ElementState s = element_kinematics(model, el, x);
   ElementResult result;
   Eigen::Matrix2d N = Eigen::Matrix2d::Zero(), M = Eigen::Matrix2d::Zero();
   const double half_thickness = 0.5 * el.thickness;
@@ -149,6 +159,14 @@ ElementResult add_element_internal_force(const ShellModel& model, const ShellEle
       forces.col(el.opposite[i]) += g(i) * other.grad_opposite;
       forces.col(ia) += g(i) * other.grad_start;
       forces.col(ib) += g(i) * other.grad_end;
+    } else if (el.edge_kind[i] == EdgeKind::mirror) {
+      // The ghost vertex is the reflection R x_i (R = I - 2 n n): chain rule through R.
+      const HingeSide& other = s.neighbour_side[i];
+      const Eigen::Vector3d& n = model.mirror_planes[static_cast<std::size_t>(el.mirror_plane[i])].normal;
+      const Eigen::Vector3d& d = other.grad_opposite;
+      forces.col(el.nodes[i]) += g(i) * (d - 2.0 * n.dot(d) * n);
+      forces.col(ia) += g(i) * other.grad_start;
+      forces.col(ib) += g(i) * other.grad_end;
     }
   }
   return result;
@@ -164,7 +182,7 @@ struct ElementFieldValues {
 template <class Law>
 ElementFieldValues element_field_values(const ShellModel& model, const ShellElement& el, const Law& law,
                                         const Eigen::Matrix3Xd& x) {
-  const ElementState s = element_kinematics(el, x);
+  const ElementState s = element_kinematics(model, el, x);
   ElementFieldValues out;
   out.max_principal_stress = -std::numeric_limits<double>::infinity();
   out.max_principal_log_strain = -std::numeric_limits<double>::infinity();

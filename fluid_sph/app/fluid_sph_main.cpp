@@ -99,8 +99,9 @@ int run(const valvefsi::cases::Case& c, const std::filesystem::path& case_file, 
   series.flush();
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   const double updates = static_cast<double>(p.size()) * static_cast<double>(solver.step_count() - first_step);
-  spdlog::info("fluid_sph: done, t = {} s in {} steps, wall time {:.1f} s ({:.3g} particle updates/s), {} particle(s) lost, output in {}",
-               solver.time(), solver.step_count(), wall, updates / std::max(wall, 1e-9), solver.lost_count(), output.string());
+  spdlog::info("fluid_sph: done, t = {} s in {} steps, wall time {:.1f} s ({:.3g} particle updates/s), {} particle(s) lost ({} of them by density out of range), output in {}",
+               solver.time(), solver.step_count(), wall, updates / std::max(wall, 1e-9), solver.lost_count(),
+               solver.density_out_of_range_count(), output.string());
   return solver.lost_count() == 0 ? 0 : 3;
 }
 

@@ -112,6 +112,7 @@ void CellGrid<D>::sort(Particles<D>& p) {
   for (int d = 0; d < D; ++d) p.local_position[d].resize(n);
   p.fluid_mask.resize(n);
   p.inverse_density.resize(n);
+  p.near_fluid.resize(n);
   // One parallel region for all arrays: the gathers share no barrier until the end.
 #pragma omp parallel
   {

@@ -52,7 +52,8 @@ void FluidSolver<D>::evaluate_rates() {
   update_wall_state<D>(particles_, grid_, settings_, body_acceleration_);
   compute_fluid_rates<D>(particles_, grid_, settings_);
   if (!plates_.empty() || body_forces_requested_ || body_forces_always_) {
-    body_forces_ = compute_body_forces<D>(particles_, grid_, settings_, plates_.size() + 1);
+    body_forces_ = compute_body_forces<D>(particles_, grid_, settings_, plates_.size() + 1,
+                                          body_forces_requested_ || body_forces_always_);
     body_forces_requested_ = false;
   }
 }
@@ -107,9 +108,18 @@ void FluidSolver<D>::step() {
 
   // Second kick: velocity to the full step, density corrected to the trapezoidal rule.
   float max_speed2 = 0.0f, max_acc2 = 0.0f;
-#pragma omp parallel for schedule(static) reduction(max : max_speed2, max_acc2)
+  const float density_limit = static_cast<float>(settings_.max_density_deviation * settings_.rest_density);
+  std::size_t out_of_range = 0;
+#pragma omp parallel for schedule(static) reduction(max : max_speed2, max_acc2) reduction(+ : out_of_range)
   for (std::ptrdiff_t i = 0; i < n; ++i) {
     if (p.kind[i] != Kind::fluid) continue;
+    // Like DualSPHysics' RhopOut: a particle whose density leaves the band (a splash droplet
+    // expanding without neighbours) is taken out rather than allowed to blow up the step.
+    if (std::abs(p.density_excess[i]) > density_limit) {
+      p.kind[i] = Kind::lost;
+      ++out_of_range;
+      continue;
+    }
     float v2 = 0.0f, a2 = 0.0f;
     for (int d = 0; d < D; ++d) {
       p.velocity[d][i] += half * p.acceleration[d][i];
@@ -122,6 +132,8 @@ void FluidSolver<D>::step() {
   }
   max_speed_ = std::sqrt(max_speed2);
   max_acceleration_ = std::sqrt(max_acc2);
+  lost_ += out_of_range;
+  lost_density_ += out_of_range;
   if (settings_.shifting > 0) shift_particles(dt);
   ++steps_;
   choose_time_step();

@@ -115,7 +115,8 @@ inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, con
       const float dvx = va[0] - v0[b], dvy = va[1] - v1[b], dvz = D == 3 ? va[2] - v2[b] : 0.0f;
       const float vdx = dvx * dx + dvy * dy + dvz * dz;
       cont += vdx * weight;
-      float radial = -(p_a + pr[b]) * inv_rr;
+      // As in cell_block_rates: a wall feels only the fluid's positive pressure.
+      float radial = -(p_a + (OnlyFluidNeighbours ? std::max(pr[b], 0.0f) : pr[b])) * inv_rr;
       if constexpr (WithArtificialViscosity) {
         const float mu_ab = k.h * std::min(vdx, 0.0f) / (r2 + k.eta2);
         radial += k.alpha_c0 * mu_ab * 0.5f * (inv_a + inv_b);
@@ -199,7 +200,10 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, class Kernel>
           const float inv_rr = inva[i] * inv_b;
           const float vdx = (va[0][i] - vxb) * dx + (va[1][i] - vyb) * dy + (D == 3 ? (va[2][i] - vzb) * dz : 0.0f);
           cont[i] += vdx * F;
-          float radial = -(pa[i] + p_b) * inv_rr;
+          // Against a wall only the fluid's positive pressure counts: walls push, never pull
+          // (a tensile surge tip would otherwise be sucked into the wall it hits).
+          const float pa_wall = std::max(pa[i], 0.0f);
+          float radial = -(p_b + pa_wall + is_fluid * (pa[i] - pa_wall)) * inv_rr;
           if constexpr (WithArtificialViscosity) {
             const float mu_ab = k.h * std::min(vdx, 0.0f) / (r2 + k.eta2);
             radial += k.alpha_c0 * mu_ab * 0.5f * (inva[i] + inv_b);
@@ -293,6 +297,7 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
       // Adami et al. 2012, eq. 27: p_w = (sum p_f W + (g - a_w) . sum rho_f r_wf W) / sum W;
       // no-slip by the extrapolated velocity, v_w^visc = 2 v_w - v~ (their eq. 22-23).
       const auto& a_w = body_acceleration[p.body[w]];
+      p.near_fluid[w] = sum_w > 0.0f;
       if (sum_w > 0.0f) {
         double pw = sum_p;
         for (int d = 0; d < D; ++d) pw += (s.gravity[d] - a_w[d]) * sum_rho_r[d];
@@ -351,14 +356,15 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
 
 template <int D>
 std::vector<Vec<D>> compute_body_forces(const Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s,
-                                        std::size_t body_count) {
+                                        std::size_t body_count, bool include_fixed_walls) {
   const PairConstants<D> k(s);
   const ParticleView<D> view(p);
   const int threads = omp_get_max_threads();
   std::vector<double> per_thread(static_cast<std::size_t>(threads) * body_count * D, 0.0);
   with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
     for_each_particle_with_neighbours<D>(grid, [&](std::uint32_t w, const auto& segments, int count) {
-      if (p.kind[w] != Kind::wall || p.body[w] >= body_count) return;
+      if (p.kind[w] != Kind::wall || p.body[w] >= body_count || !p.near_fluid[w]) return;
+      if (p.body[w] == 0 && !include_fixed_walls) return;
       const Rates3 r = k.alpha_c0 > 0 ? pair_sums<D, true, true, false>(view, k, W, w, segments, count)
                                       : pair_sums<D, false, true, false>(view, k, W, w, segments, count);
       double* f = per_thread.data() + (static_cast<std::size_t>(omp_get_thread_num()) * body_count + p.body[w]) * D;
@@ -378,7 +384,7 @@ template void update_wall_state<2>(Particles<2>&, const CellGrid<2>&, const Flui
 template void update_wall_state<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, const std::vector<Vec<3>>&);
 template void compute_fluid_rates<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&);
 template void compute_fluid_rates<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&);
-template std::vector<Vec<2>> compute_body_forces<2>(const Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, std::size_t);
-template std::vector<Vec<3>> compute_body_forces<3>(const Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, std::size_t);
+template std::vector<Vec<2>> compute_body_forces<2>(const Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, std::size_t, bool);
+template std::vector<Vec<3>> compute_body_forces<3>(const Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, std::size_t, bool);
 
 }  // namespace valvefsi::fluid

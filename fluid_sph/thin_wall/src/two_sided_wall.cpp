@@ -214,21 +214,26 @@ void TwoSidedWall::add_wall_rates(Particles<2>& p) {
           const Vec2 q = wall_.point(seg, tw);
           const MarkerWeights mw = markers_.weights_at(markers_.arc_length(seg, tw));
           int k_state = k_side;
-          if (settings_.opposite_state_beyond_edge) {
+          bool beyond = false;
+          if (settings_.opposite_state_beyond_edge || settings_.fluid_velocity_beyond_edge) {
             const Vec2 e{wall_.position[seg + 1][0] - wall_.position[seg][0], wall_.position[seg + 1][1] - wall_.position[seg][1]};
             const double along = ((xv[0] - wall_.position[seg][0]) * e[0] + (xv[1] - wall_.position[seg][1]) * e[1]) / dot(e, e);
-            const bool beyond = (seg == 0 && along < 0.0) || (seg + 1 == wall_.segment_count() && along > 1.0);
-            if (beyond) k_state = 1 - k_side;
+            beyond = (seg == 0 && along < 0.0) || (seg + 1 == wall_.segment_count() && along > 1.0);
+            if (beyond && settings_.opposite_state_beyond_edge) k_state = 1 - k_side;
           }
           const SideState& s0 = markers_[mw.first].side[k_state];
           const SideState& s1 = markers_[mw.second].side[k_state];
-          const Vec2 vw = wall_.velocity_at(seg, tw);
+          Vec2 vw = wall_.velocity_at(seg, tw);
+          if (beyond && settings_.fluid_velocity_beyond_edge)
+            for (int d = 0; d < 2; ++d) vw[d] = mw.w0 * s0.extrapolated_velocity[d] + mw.w1 * s1.extrapolated_velocity[d];
           const Vec2 aw = wall_.acceleration_at(seg, tw);
           double p_v = mw.w0 * s0.pressure + mw.w1 * s1.pressure;
           for (int d = 0; d < 2; ++d) p_v += rho0 * (fluid_.gravity[d] - aw[d]) * (xv[d] - q[d]);
           Vec2 vv_v;
           for (int d = 0; d < 2; ++d)
-            vv_v[d] = 2.0 * vw[d] - (mw.w0 * s0.extrapolated_velocity[d] + mw.w1 * s1.extrapolated_velocity[d]);
+            vv_v[d] = beyond && settings_.fluid_velocity_beyond_edge
+                          ? vw[d]
+                          : 2.0 * vw[d] - (mw.w0 * s0.extrapolated_velocity[d] + mw.w1 * s1.extrapolated_velocity[d]);
           const double inv_v = 1.0 / (rho0 + eos.density_excess(p_v - fluid_.background_pressure));
           const double dist = std::sqrt(r2);
           const double F = W.gradient_factor(static_cast<float>(dist));

@@ -31,6 +31,9 @@ struct FluidSettings {
   double shifting = 0.0;
   double max_shift_fraction = 0.05;
   double free_surface_kernel_sum = 0.9;
+  // A fluid particle whose |rho - rho0| exceeds this fraction of rho0 is taken out of the
+  // run (counted as lost), as DualSPHysics does with RhopOutMin/Max (700-1300 for water).
+  double max_density_deviation = 0.3;
   double cfl = 0.2;                     // Courant number of the acoustic and force limits
   double max_time_step = std::numeric_limits<double>::infinity();  // s
   int sort_interval = 1;                // re-sort particles by cell every this many steps

@@ -25,14 +25,17 @@ class FluidSolver {
   double time() const { return time_; }
   double time_step() const { return dt_; }
   long step_count() const { return steps_; }
+  // Particles taken out of the run: left the domain, or density out of range (of those).
   std::size_t lost_count() const { return lost_; }
+  std::size_t density_out_of_range_count() const { return lost_density_; }
   const FluidSettings<D>& settings() const { return settings_; }
   const Particles<D>& particles() const { return particles_; }
   const CellGrid<D>& grid() const { return grid_; }
   const std::vector<PressurePlate<D>>& plates() const { return plates_; }
 
   // Force of the fluid on body k (0: fixed walls, k: plates[k-1]) at the last step that
-  // computed it: every step when plates exist, otherwise after request_body_forces().
+  // computed it: plates every step; the fixed walls only after request_body_forces() or
+  // with compute_body_forces_every_step(true) (otherwise their entry stays zero).
   const std::vector<Vec<D>>& body_forces() const { return body_forces_; }
   void request_body_forces() { body_forces_requested_ = true; }
   void compute_body_forces_every_step(bool on) { body_forces_always_ = on; }
@@ -54,6 +57,7 @@ class FluidSolver {
   double dt_ = 0.0;
   long steps_ = 0;
   std::size_t lost_ = 0;
+  std::size_t lost_density_ = 0;
   float max_speed_ = 0.0f;
   float max_acceleration_ = 0.0f;
 };

@@ -27,9 +27,12 @@ void update_wall_state(Particles<D>& particles, const CellGrid<D>& grid, const F
 template <int D>
 void compute_fluid_rates(Particles<D>& particles, const CellGrid<D>& grid, const FluidSettings<D>& settings);
 
-// Force (N; per unit depth in 2D) of the fluid on each body 0..body_count-1.
+// Force (N; per unit depth in 2D) of the fluid on each body 0..body_count-1; the fixed walls
+// (body 0) only if include_fixed_walls (they are usually most of the dummy particles).
+// Only wall particles with fluid in their kernel (update_wall_state marks them) are visited.
 template <int D>
 std::vector<Vec<D>> compute_body_forces(const Particles<D>& particles, const CellGrid<D>& grid,
-                                        const FluidSettings<D>& settings, std::size_t body_count);
+                                        const FluidSettings<D>& settings, std::size_t body_count,
+                                        bool include_fixed_walls);
 
 }  // namespace valvefsi::fluid

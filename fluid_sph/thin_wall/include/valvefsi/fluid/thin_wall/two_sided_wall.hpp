@@ -39,6 +39,10 @@ struct ThinWallSettings {
   // give them the other side's state at the end instead of the particle's own side's.
   // (A measured alternative for the free edge; docs/thin-leaflet.md.)
   bool opposite_state_beyond_edge = false;
+  // Virtual points beyond a free end move with the extrapolated fluid velocity (in the
+  // continuity and viscous terms) instead of the wall's: the fluid there flows round the edge
+  // and is not a wall. (A measured alternative; docs/thin-leaflet.md.)
+  bool fluid_velocity_beyond_edge = false;
 };
 
 // What the model knows of one particle after classify (sorted index).

@@ -11,6 +11,7 @@ cd "$root"
 jobs=$(nproc 2>/dev/null || echo 2)
 
 bash scripts/setup-debian.sh
+export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$jobs"

@@ -130,6 +130,7 @@ def stop_all(programs, grace):
 
 
 def main():
+    started_at = time.monotonic()
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("case", type=Path, help="case file (cases/*.textproto)")
     parser.add_argument("--output", type=Path, help="output folder (default: the case's run.output_dir)")
@@ -215,8 +216,11 @@ def main():
         time.sleep(0.05)
     for program in programs:
         program.close()
+    wall_s = time.monotonic() - started_at
     if exit_code == 0:
-        print(f"run_case: finished; logs and results in {output_dir}", flush=True)
+        print(f"run_case: finished in {wall_s:.1f} s wall time; logs and results in {output_dir}", flush=True)
+    else:
+        print(f"run_case: stopped after {wall_s:.1f} s wall time", file=sys.stderr, flush=True)
     sys.exit(exit_code)
 
 

@@ -77,6 +77,23 @@ TEST(Launcher, StandinCaseRunsEndToEndWithPrefixedLogs) {
   expect_nothing_left(output);
 }
 
+TEST(Launcher, FluidRanksStartTheFluidUnderMpirun) {
+  const auto dir = fresh_directory("launch-mpi");
+  const auto output = dir / "run";
+  auto launcher = launch(VALVEFSI_TEST_SOURCE_DIR "/cases/standin-plate.textproto", output, {"--fluid-ranks", "2"});
+  ASSERT_EQ(launcher->wait_for_exit(60s), std::optional<int>(0)) << launcher->log_text();
+  std::ifstream fluid_log(output / "fluid.log");
+  std::stringstream fluid_text;
+  fluid_text << fluid_log.rdbuf();
+  EXPECT_NE(fluid_text.str().find("MPI rank 1 of 2: idle"), std::string::npos) << fluid_text.str();
+  // The coupled result is the same as with one fluid process.
+  std::ifstream solid_log(output / "solid.log");
+  std::stringstream solid_text;
+  solid_text << solid_log.rdbuf();
+  EXPECT_NEAR(final_plate_z(solid_text.str()), 2e-3 * (1.0 - std::cos(5.0)), 1e-12);
+  expect_nothing_left(output);
+}
+
 TEST(Launcher, FailingParticipantStopsTheOthersAndItsCodeIsReturned) {
   const auto dir = fresh_directory("launch-fail");
   const auto output = dir / "run";

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <cstdlib>
 #include <limits>
 
 #include <Eigen/Geometry>
@@ -21,6 +22,15 @@ int main(int argc, char** argv) {
   app.add_option("--pressure", pressure, "pressure pushing along +z (Pa)");
   app.add_option("--propose-window", proposed_window, "max_stable_window to propose (s), 0 = none");
   CLI11_PARSE(app, argc, argv);
+
+  // Under mpirun only rank 0 takes part, as rank 0 of an MPI fluid gathers and scatters the
+  // interface data; the other ranks have nothing to do here. Open MPI names the rank in the
+  // environment, so the stand-in needs no MPI library to prove the launcher's mpirun path.
+  if (const char* rank = std::getenv("OMPI_COMM_WORLD_RANK"); rank != nullptr && std::string(rank) != "0") {
+    const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
+    spdlog::info("standin_fluid_pressure: MPI rank {} of {}: idle (rank 0 takes part)", rank, size ? size : "?");
+    return 0;
+  }
 
   std::unique_ptr<valvefsi::coupling::Participant> participant;
   return valvefsi::standins::run_guarded("standin_fluid_pressure", participant, [&] {

@@ -93,7 +93,9 @@ class Program:
         for raw in iter(self.process.stdout.readline, b""):
             line = raw.decode("utf-8", "replace")
             self.log.write(line)
-            sys.stdout.write(f"[{self.role}] {line}")
+            # A program that already tags its lines with its role is not tagged twice.
+            tag = f"[{self.role}] "
+            sys.stdout.write(line if line.startswith(tag) else tag + line)
             sys.stdout.flush()
 
     def exit_code(self):

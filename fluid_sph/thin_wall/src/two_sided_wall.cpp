@@ -289,6 +289,13 @@ void TwoSidedWall::begin_step(const Particles<2>& p) {
 void TwoSidedWall::correct_crossings(Particles<2>& p) {
   const double R = fluid_.support_radius();
   const double clearance = settings_.clearance_ratio * fluid_.particle_spacing;
+  if (start_nodes_.size() != wall_.position.size() || start_position_.size() != p.size()) return;  // no begin_step yet
+  // The box swept by the wall over the step (classify's box is the last step's).
+  std::array<double, 4> box{start_nodes_[0][0], start_nodes_[0][1], start_nodes_[0][0], start_nodes_[0][1]};
+  for (const auto* nodes : {&start_nodes_, &wall_.position})
+    for (const auto& x : *nodes) {
+      box = {std::min(box[0], x[0]), std::min(box[1], x[1]), std::max(box[2], x[0]), std::max(box[3], x[1])};
+    }
   std::size_t corrections = 0;
   const auto count = static_cast<std::ptrdiff_t>(p.size());
 #pragma omp parallel for schedule(dynamic, 256) reduction(+ : corrections)
@@ -297,7 +304,7 @@ void TwoSidedWall::correct_crossings(Particles<2>& p) {
     if (p.kind[i] != Kind::fluid) continue;
     const Vec2 x0 = start_position_[i];
     Vec2 x1 = position_of(p, i);
-    if (x0[0] < wall_box_[0] - R || x0[0] > wall_box_[2] + R || x0[1] < wall_box_[1] - R || x0[1] > wall_box_[3] + R) continue;
+    if (x0[0] < box[0] - R || x0[0] > box[2] + R || x0[1] < box[1] - R || x0[1] > box[3] + R) continue;
     const auto hit = swept_crossing(start_nodes_, wall_.position, x0, x1);
     if (!hit) continue;
     const std::size_t k = hit->segment;

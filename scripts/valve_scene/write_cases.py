@@ -1,4 +1,5 @@
-"""Writes the TAV case files (cases/*.textproto) and the valve meshes they use.
+"""Writes the TAV case files (cases/*.textproto) and the valve meshes they use (and, through
+valve2d, the 2D scene's cases and strip meshes).
 
     cd scripts && /usr/bin/python3 -m valve_scene.write_cases [--cases-dir ../cases]
 
@@ -177,6 +178,8 @@ def main(argv=None) -> None:
     paths = write_cases(args.cases_dir)
     if not args.no_meshes:
         paths += write_meshes(args.cases_dir)
+    from .valve2d import write_2d   # the 2D scene's cases and strip meshes
+    paths += write_2d(args.cases_dir, meshes=not args.no_meshes)
     for path in paths:
         print(path)
 

@@ -56,6 +56,46 @@ TEST(SceneCaseFiles, LoadAndMatchTheirNames) {
   }
 }
 
+TEST(SceneCaseFiles, TwoDimensionalCasesLoad) {
+  // scripts/valve_scene/valve2d.py: FE and FSI x Ogden and MHGO x coarse and medium
+  const std::regex name_2d(R"((fe|fsi)-(ogden|mhgo)-2d-(coarse|medium)\.textproto)");
+  int found = 0;
+  for (const auto& entry : fs::directory_iterator(VALVEFSI_CASES_DIR)) {
+    std::smatch m;
+    const std::string name = entry.path().filename().string();
+    if (!std::regex_match(name, m, name_2d)) continue;
+    SCOPED_TRACE(name);
+    ++found;
+    valvefsi::cases::Case c;
+    ASSERT_NO_THROW(c = valvefsi::load_case(entry.path()));
+    EXPECT_EQ(c.run().dimension(), 2);
+    EXPECT_EQ(c.run().fe_only(), m[1] == "fe");
+    EXPECT_DOUBLE_EQ(c.run().end_time(), 1.6);
+    EXPECT_EQ(c.solid().mesh_file(), "meshes/valve-2d-" + m[3].str() + ".mesh.h5");
+    EXPECT_DOUBLE_EQ(c.solid().strip_depth(), 1e-3);
+    if (m[1] == "fsi") {
+      const auto& f = c.fluid();
+      EXPECT_DOUBLE_EQ(f.particle_spacing(), m[3] == "coarse" ? 1e-3 : 0.5e-3);
+      EXPECT_EQ(f.domain_lower_size(), 2);
+      EXPECT_EQ(f.lattice_origin_size(), 2);
+      EXPECT_EQ(f.plates_size(), 2);
+      EXPECT_EQ(f.plates(0).pressure_source(), valvefsi::cases::FluidPressurePlate::VENTRICULAR);
+      EXPECT_EQ(f.plates(1).pressure_source(), valvefsi::cases::FluidPressurePlate::AORTIC);
+      // the plates' offset and the background pressure cancel: no step load at t = 0
+      EXPECT_NEAR(f.plates(0).pressure_mmhg() * valvefsi::kPascalPerMmHg + f.background_pressure(), 0.0, 1e-3);
+      const valvefsi::PressureWaveform wf(c.waveform(), name);
+      EXPECT_NEAR(wf.aortic_pressure(0.0) + f.plates(1).pressure_mmhg() * valvefsi::kPascalPerMmHg, 0.0, 1.0);
+      EXPECT_NEAR(wf.ventricular_pressure(0.0) + f.plates(0).pressure_mmhg() * valvefsi::kPascalPerMmHg, 0.0, 1.0);
+      EXPECT_EQ(f.probes().pressure_points_size(), 2);
+      EXPECT_GE(f.probes().flow_planes_size(), 3);
+      EXPECT_TRUE(f.has_thin_walls());
+      EXPECT_GT(c.coupling().window_size(), 0.0);
+      EXPECT_LE(c.coupling().window_size(), 1e-5);
+    }
+  }
+  EXPECT_EQ(found, 8);
+}
+
 TEST(SceneCaseFiles, WaveformGivesTheReferencePressures) {
   const auto files = scene_cases();
   ASSERT_FALSE(files.empty());

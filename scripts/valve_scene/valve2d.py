@@ -1,0 +1,441 @@
+"""The 2D valve scene (issue 7, item 1): two leaflets in a plane channel through the valve axis,
+as a strip mesh for solid_fe and FE-only / FSI case files.
+
+    cd scripts && /usr/bin/python3 -m valve_scene.valve2d [--cases-dir ../cases] [--png X.png]
+
+Frame (2D, docs/valve-scene.md "2D valve scene"): x is the axial flow direction (ventricle
+x < 0, aorta x > 0), y the radial direction, z out of plane; the leaflets' attached ends are
+on the stent's inner faces y = +-R at x = 0 (the 3D leaflet base).
+
+Each leaflet is the radial-axial section of the 3D valve through a leaflet belly (the bisecting
+plane s = 0 of valve_geometry): the Bezier curve from the attachment base (r = R, z = 0) to the
+free-edge midpoint, mapped (r, z) -> (x = z, y = +-r); leaflet 0 is the upper one (y > 0).
+The strip (shared contract, docs/valve-scene.md): the polyline at z = 0 (node set strip_front)
+and its copy at z = strip_depth (strip_back), two shell triangles per segment, normals toward
+the outflow side as in 3D, circumferential axis +z, radial axis along the polyline.
+"""
+from __future__ import annotations
+
+import argparse
+import functools
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import waveform
+from .mesh_io import write_mesh
+from .tube import TubeSetup
+from .valve_geometry import ValveParameters
+from .valve_mesh import ValveMesh, leaflet_grid
+
+CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
+# Segments per leaflet: the 3D mesh's rows from attachment to free edge (valve_mesh.RESOLUTIONS).
+SEGMENTS = {"coarse": 14, "medium": 28}
+# Fluid particle spacing: about one leaflet segment (1.16 / 0.58 mm).
+PARTICLE_SPACING_2D = {"coarse": 1.0e-3, "medium": 0.5e-3}
+STRIP_DEPTH = 1.0e-3            # m; solid_case.proto's default strip_depth
+LEAFLETS_2D = 2
+PA_PER_MMHG = 133.322387415
+CYCLES = 2
+BLOOD_DENSITY = 1056.0          # kg/m^3 (reference Sec. 2.3)
+LEAFLET_DENSITY = 1100.0        # kg/m^3 (reference Sec. 2.2)
+
+
+def belly_section(p: ValveParameters, segments: int) -> np.ndarray:
+    """(axial, radial) of the leaflet's bisecting-plane section, [segments + 1, 2], uniform in
+    arc length, from the attachment base to the free-edge midpoint."""
+    column = leaflet_grid(p, 2, segments)[1]   # s = 0: the plane y = 0, x = radial coordinate
+    return np.stack([column[:, 2], column[:, 0]], axis=1)
+
+
+def leaflet_polylines(p: ValveParameters, segments: int) -> list[np.ndarray]:
+    """Mid-lines of the two 2D leaflets in the x-y plane, each [segments + 1, 2], attached end
+    first: leaflet 0 at y > 0, leaflet 1 its mirror image."""
+    section = belly_section(p, segments)
+    upper = section.copy()
+    lower = section * np.array([1.0, -1.0])
+    return [upper, lower]
+
+
+def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None = None,
+                     strip_depth: float = STRIP_DEPTH, segments: int | None = None) -> ValveMesh:
+    """The two leaflets as one-element-deep strips (plane strain in solid_fe)."""
+    p = params or ValveParameters()
+    p.validate()
+    if segments is None:
+        if resolution not in SEGMENTS:
+            raise ValueError(f"2D resolution '{resolution}': allowed {', '.join(SEGMENTS)}")
+        segments = SEGMENTS[resolution]
+    if segments < 1:
+        raise ValueError(f"segments {segments}: allowed >= 1")
+    if not strip_depth > 0:
+        raise ValueError(f"strip_depth {strip_depth!r}: allowed > 0")
+    lines = leaflet_polylines(p, segments)
+    n = segments + 1
+    front = np.concatenate([np.column_stack([line, np.zeros(n)]) for line in lines])
+    back = front + np.array([0.0, 0.0, strip_depth])
+    mesh = ValveMesh(nodes=np.concatenate([front, back]))
+    count = len(front)   # back node of front node i is i + count
+
+    tris, radial = [], []
+    for k, line in enumerate(lines):
+        for i in range(segments):
+            f0, f1 = k * n + i, k * n + i + 1
+            b0, b1 = f0 + count, f1 + count
+            # e_z x d points to the outflow side for the upper leaflet, d x e_z for the mirrored lower one
+            if k == 0:
+                tris += [[f0, b1, f1], [f0, b0, b1]]
+            else:
+                tris += [[f0, f1, b1], [f0, b1, b0]]
+            d = line[i + 1] - line[i]
+            d = np.append(d / np.linalg.norm(d), 0.0)
+            radial += [d, d]
+    mesh.triangles = np.array(tris, dtype=np.int64)
+    mesh.triangle_thickness = np.full(len(tris), p.thickness)
+    mesh.triangle_circumferential = np.tile([0.0, 0.0, 1.0], (len(tris), 1))
+    mesh.triangle_radial = np.array(radial)
+
+    def both_layers(ids) -> np.ndarray:
+        ids = np.asarray(ids, dtype=np.int64)
+        return np.sort(np.concatenate([ids, ids + count]))
+
+    attached = [k * n for k in range(LEAFLETS_2D)]
+    free = [k * n + segments for k in range(LEAFLETS_2D)]
+    mesh.node_sets["strip_front"] = np.arange(count, dtype=np.int64)
+    mesh.node_sets["strip_back"] = np.arange(count, 2 * count, dtype=np.int64)
+    mesh.node_sets["attachment"] = both_layers(attached)
+    mesh.node_sets["free_edge"] = both_layers(free)
+    mesh.node_sets["free_edge_midpoints"] = np.array(free, dtype=np.int64)
+    mesh.node_sets["triangle_nodes"] = np.arange(2 * count, dtype=np.int64)
+    per_leaflet = 2 * segments
+    for k in range(LEAFLETS_2D):
+        mesh.node_sets[f"leaflet_{k}"] = both_layers(np.arange(k * n, (k + 1) * n))
+        mesh.element_sets[f"leaflet_{k}_triangles"] = (
+            "triangle", np.arange(k * per_leaflet, (k + 1) * per_leaflet, dtype=np.int64))
+    mesh.description = {
+        "generator": "valve_scene.valve2d",
+        "variant": "2d",
+        "resolution": resolution if segments == SEGMENTS.get(resolution) else f"{segments}",
+        "segments_per_leaflet": segments,
+        "leaflet_count_in_file": LEAFLETS_2D,
+        "strip_depth": strip_depth,
+        **{f"param_{name}": value for name, value in p.__dict__.items()},
+    }
+    return mesh
+
+
+def leaflet_length(p: ValveParameters, segments: int = 400) -> float:
+    section = belly_section(p, segments)
+    return float(np.linalg.norm(np.diff(section, axis=0), axis=1).sum())
+
+
+# ---------------------------------------------------------------------------------------------
+# The channel and the fluid part of the FSI case
+
+
+@dataclass(frozen=True)
+class Channel2D:
+    """The ISO tube's axial section as a channel (m). Defaults from TubeSetup and ValveParameters
+    so that the 2D and 3D scenes share their dimensions."""
+    width: float = TubeSetup().tube_diameter                   # 36.8 mm
+    stent_radius: float = ValveParameters().annulus_radius      # orifice half-width (23 mm orifice)
+    stent_start: float = TubeSetup().gasket_z - TubeSetup().gasket_thickness   # -6 mm: gasket's upstream face
+    stent_end: float = ValveParameters().commissure_height      # 12 mm: commissure tops
+    upstream_length: float = TubeSetup().upstream_length        # leaflet base -> inlet plate
+    downstream_length: float = TubeSetup().downstream_length    # leaflet base -> outlet plate
+    upstream_tap_distance: float = TubeSetup().upstream_tap_distance      # 1 valve diameter
+    downstream_tap_distance: float = TubeSetup().downstream_tap_distance  # 3 valve diameters
+    velocity_probe_distance: float = 15.0e-3                    # reference Fig. 11c
+    # flow-rate sections (x, m): upstream tap, stent inflow, 30 mm downstream, downstream tap
+    flow_sections: tuple = field(default=(-23.0e-3, -3.0e-3, 30.0e-3, 69.0e-3))
+    plate_travel_per_cycle: float = 60.0e-3   # allowance; the lumped estimate is ~5 cm (docs)
+
+    def validate(self) -> None:
+        checks = [
+            ("width", self.width > 2 * self.stent_radius, "> 2 stent_radius"),
+            ("stent_radius", self.stent_radius > 0, "> 0"),
+            ("stent_start", -self.upstream_length < self.stent_start < 0, "in (-upstream_length, 0)"),
+            ("stent_end", 0 < self.stent_end < self.downstream_length, "in (0, downstream_length)"),
+            ("upstream_tap_distance", 0 < self.upstream_tap_distance < self.upstream_length, "in (0, upstream_length)"),
+            ("downstream_tap_distance", 0 < self.downstream_tap_distance < self.downstream_length, "in (0, downstream_length)"),
+            ("velocity_probe_distance", 0 < self.velocity_probe_distance < self.downstream_length, "in (0, downstream_length)"),
+            ("flow_sections", all(-self.upstream_length < x < self.downstream_length for x in self.flow_sections),
+             "every x in (-upstream_length, downstream_length)"),
+            ("plate_travel_per_cycle", self.plate_travel_per_cycle >= 0, ">= 0"),
+        ]
+        for name, ok, allowed in checks:
+            if not ok:
+                raise ValueError(f"2D channel parameter '{name}' = {getattr(self, name)!r}: allowed {allowed}")
+
+
+@functools.lru_cache(maxsize=None)
+def peak_forward_velocity() -> float:
+    """Bernoulli jet speed of the waveform's peak forward gradient (m/s): sqrt(2 dp / rho)."""
+    t = np.linspace(0.0, waveform.PERIOD_S, 8001)
+    dp = float(np.max(waveform.transvalvular_pressure_mmHg(t))) * PA_PER_MMHG
+    return math.sqrt(2.0 * dp / BLOOD_DENSITY)
+
+
+def sound_speed_2d() -> float:
+    """10x the expected peak speed: the Bernoulli speed (1.57 m/s) rounded up to 0.5 m/s, so
+    the Mach number stays <= 0.1 (density variation ~1 %)."""
+    return 10.0 * math.ceil(2.0 * peak_forward_velocity()) / 2.0
+
+
+def coupling_window(sound_speed: float, valve: ValveParameters | None = None) -> float:
+    """Largest window with mu = 2 rho_f c dt / (rho_s t) <= 1 (docs/coupling-numerics.md (b):
+    serial explicit is stable for mu < 2; the leaflet has fluid on both sides, hence the 2),
+    rounded down to 0.5 us."""
+    valve = valve or ValveParameters()
+    window = LEAFLET_DENSITY * valve.thickness / (2.0 * BLOOD_DENSITY * sound_speed)
+    return math.floor(window / 0.5e-6) * 0.5e-6
+
+
+def aortic_pressure_at_opening_mmHg() -> float:
+    return round(float(waveform.aortic_pressure_mmHg()(np.array([0.0]))[0]), 2)
+
+
+def _vec(values) -> str:
+    return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
+
+
+def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Channel2D | None = None,
+                   sound_speed: float | None = None) -> str:
+    """The `fluid { ... }` block of the 2D FSI case (valvefsi.cases.FluidCase, 2-vectors)."""
+    ch = channel or Channel2D()
+    ch.validate()
+    dp = particle_spacing
+    c0 = sound_speed or sound_speed_2d()
+    half = 0.5 * ch.width
+    plate = 3 * dp
+    x_in, x_out = -ch.upstream_length, ch.downstream_length
+    channel_start = x_in - plate - 2 * dp
+    channel_end = x_out + plate + cycles * ch.plate_travel_per_cycle + 2 * dp
+    margin = 6 * dp
+    offset = aortic_pressure_at_opening_mmHg()
+    background = offset * PA_PER_MMHG
+    wall_top = half + margin
+    lines = [
+        "fluid {",
+        f"  particle_spacing: {dp:g}",
+        "  kernel: CUBIC_SPLINE",
+        f"  density: {BLOOD_DENSITY:g}",
+        "  dynamic_viscosity: 0.0035",
+        f"  # 10x the Bernoulli speed of the peak forward gradient ({peak_forward_velocity():.2f} m/s, rounded up)",
+        f"  sound_speed: {c0:g}",
+        "  density_diffusion: 0.1",
+        "  # shifting keeps the leaflets' free ends stable (docs/thin-leaflet.md)",
+        "  shifting: 1",
+        f"  # the fluid starts at the aortic pressure at opening ({offset:g} mmHg): background pressure",
+        "  # plus the plates' offset below, so neither plate starts with a step load",
+        f"  background_pressure: {background:.9g}",
+        f"  domain_lower: {_vec([channel_start - margin, -half - margin])}",
+        f"  domain_upper: {_vec([channel_end + margin, half + margin])}",
+        "  # the stent faces y = +-R lie on lattice planes (the channel walls 0.1 mm off them)",
+        f"  lattice_origin: {_vec([0.0, -ch.stent_radius])}",
+        f"  fluid_blocks {{ box {{ lower: {_vec([x_in, -half])} upper: {_vec([x_out, half])} }} }}",
+        f"  # the ISO tube's section: a {ch.width * 1e3:.1f} mm channel, extended past the outlet plate by its travel",
+        f"  walls {{ tube {{ origin: {_vec([channel_start, 0])} axis: [1, 0] length: {channel_end - channel_start:.6g} radius: {half:.6g} }} }}",
+        f"  # gasket + stent: rigid blocks narrowing the channel to the {2 * ch.stent_radius * 1e3:.0f} mm orifice, gasket face to commissure tops",
+        f"  walls {{ solid_box {{ lower: {_vec([ch.stent_start, ch.stent_radius])} upper: {_vec([ch.stent_end, wall_top])} }} }}",
+        f"  walls {{ solid_box {{ lower: {_vec([ch.stent_start, -wall_top])} upper: {_vec([ch.stent_end, -ch.stent_radius])} }} }}",
+        "  # inlet plate: left-ventricular pressure",
+        "  plates {",
+        f"    shape {{ solid_box {{ lower: {_vec([x_in - plate, -half])} upper: {_vec([x_in, half])} }} }}",
+        f"    normal: [1, 0] area: {ch.width:.6g} pressure_source: VENTRICULAR pressure_mmHg: {-offset:g}",
+        "  }",
+        "  # outlet plate: aortic pressure",
+        "  plates {",
+        f"    shape {{ solid_box {{ lower: {_vec([x_out, -half])} upper: {_vec([x_out + plate, half])} }} }}",
+        f"    normal: [-1, 0] area: {ch.width:.6g} pressure_source: AORTIC pressure_mmHg: {-offset:g}",
+        "  }",
+        "  probes {",
+        f"    pressure_points {{ name: \"upstream_tap\" position: {_vec([-ch.upstream_tap_distance, 0])} }}",
+        f"    pressure_points {{ name: \"downstream_tap\" position: {_vec([ch.downstream_tap_distance, 0])} }}",
+    ]
+    for x in ch.flow_sections:
+        lines.append(f"    flow_planes {{ name: \"{section_name(x)}\" point: {_vec([x, 0])} normal: [1, 0] }}")
+    lines.append(f"    velocity_planes {{ name: \"{ch.velocity_probe_distance * 1e3:g}mm_downstream\" "
+                 f"point: {_vec([ch.velocity_probe_distance, 0])} normal: [1, 0] }}")
+    lines += ["    wall_forces: true", "  }",
+              "  thin_walls { virtual_spacing_ratio: 0.5 clearance_ratio: 0.1 }", "}"]
+    return "\n".join(lines) + "\n"
+
+
+def section_name(x: float) -> str:
+    mm = round(x * 1e3, 3)
+    return f"x_{'m' if mm < 0 else 'p'}{abs(mm):g}mm"
+
+
+# ---------------------------------------------------------------------------------------------
+# Case files
+
+
+@dataclass(frozen=True)
+class Case2D:
+    kind: str          # "FE" or "FSI"
+    material: str      # "Ogden" or "MHGO"
+    resolution: str    # "coarse" or "medium"
+
+    @property
+    def name(self) -> str:
+        return f"{self.kind.lower()}-{self.material.lower()}-2d-{self.resolution}"
+
+    @property
+    def mesh_name(self) -> str:
+        return f"valve-2d-{self.resolution}.mesh.h5"
+
+
+def all_specs_2d() -> list[Case2D]:
+    return [Case2D(k, m, r) for k in ("FE", "FSI") for m in ("Ogden", "MHGO") for r in SEGMENTS]
+
+
+def header_2d(spec: Case2D) -> str:
+    from .write_cases import _wrap_comment
+    p = ValveParameters()
+    ch = Channel2D()
+    leaflet = (f"two {leaflet_length(p) * 1e3:.1f} mm leaflets (the 3D valve's belly section, "
+               f"{SEGMENTS[spec.resolution]} segments each, {p.thickness * 1e3:g} mm thick, "
+               f"plane-strain strips {STRIP_DEPTH * 1e3:g} mm deep), {spec.material} (reference Table 1), "
+               "attached ends fixed on the stent faces")
+    if spec.kind == "FE":
+        models = (f"the 2D valve: {leaflet}, under the 75 bpm Wiggers transvalvular pressure applied "
+                  f"uniformly on the leaflets with no fluid (FE-only), {CYCLES} cycles.")
+        shows = ("the leaflets open at once when the gradient turns positive (t = 0), stay open with "
+                 "flutter through ejection, close as the gradient falls to zero (~0.24 s) and stay "
+                 "closed, bulging toward the ventricle, through diastole; the second cycle repeats the first")
+        run = f"/usr/bin/python3 scripts/run_case.py cases/{spec.name}.textproto --output runs/{spec.name} --fe-only"
+    else:
+        dp = PARTICLE_SPACING_2D[spec.resolution]
+        models = (f"the 2D valve: {leaflet}, in a {ch.width * 1e3:.1f} mm channel (the ISO tube's "
+                  f"axial section) narrowed by the gasket and stent to {2 * ch.stent_radius * 1e3:.0f} mm, "
+                  f"SPH blood at {dp * 1e3:g} mm spacing (c0 = {sound_speed_2d():g} m/s), driven by the "
+                  "Wiggers ventricular and aortic pressures on two plates, serial explicit coupling "
+                  f"every {coupling_window(sound_speed_2d()) * 1e6:g} us; {CYCLES} cycles.")
+        shows = ("opening delayed and slower than FE-only (the blood's inertia), a jet through the "
+                 "orifice, closure after the gradient reverses (later than FE-only) with a brief "
+                 "regurgitant flow, a diastolic leaflet force above the hydrostatic one (water hammer), "
+                 "no particle leaking through a leaflet; hemodynamics per metre of depth "
+                 "(python -m valve_scene.hemodynamics)")
+        run = f"/usr/bin/python3 scripts/run_case.py cases/{spec.name}.textproto --output runs/{spec.name}"
+    lines = [f"# {spec.kind}-{spec.material}, 2D valve (plane channel), {spec.resolution}.", "#",
+             "# What it models: " + models,
+             "# What it should show: " + shows + ".",
+             "# Run (from the repository root; the mesh is written by",
+             "#   `cd scripts && /usr/bin/python3 -m valve_scene.valve2d`):",
+             "#   " + run,
+             "# Generated by scripts/valve_scene/valve2d.py (docs/valve-scene.md); edit that, not this file."]
+    return "\n".join(_wrap_comment(line) for line in lines) + "\n"
+
+
+def case_text_2d(spec: Case2D) -> str:
+    from .write_cases import MHGO, OGDEN
+    title = (f"{spec.kind}-{spec.material}: 2D valve in a plane channel, {spec.resolution} "
+             f"({'FE-only' if spec.kind == 'FE' else 'SPH-FE FSI'})")
+    snapshots = 0.002 if spec.kind == "FE" else 0.01
+    run = ("run {\n"
+           f"  end_time: {CYCLES * waveform.PERIOD_S:g}\n"
+           f"  output_dir: \"runs/{spec.name}\"\n"
+           f"  fe_only: {'true' if spec.kind == 'FE' else 'false'}\n"
+           "  dimension: 2\n"
+           f"  snapshot_interval: {snapshots:g}\n"
+           "  series_interval: 0.0001\n"
+           "}\n")
+    if spec.material == "Ogden":
+        law = "  material: OGDEN\n  ogden { " + " ".join(f"{k}: {v:g}" for k, v in OGDEN.items()) + " }\n"
+    else:
+        law = "  material: MHGO\n  mhgo { " + " ".join(f"{k}: {v:g}" for k, v in MHGO.items()) + " }\n"
+    solid = ("solid {\n"
+             f"  mesh_file: \"meshes/{spec.mesh_name}\"\n"
+             "  element_family: SHELL\n"
+             + law +
+             f"  density: {LEAFLET_DENSITY:g}\n"
+             + strip_depth_line() +
+             "  fixed_node_sets: \"attachment\"\n"
+             "  monitor_node_sets: \"free_edge_midpoints\"\n"
+             "}\n")
+    parts = [header_2d(spec), f"title: \"{title}\"\n", run, waveform.waveform_textproto(), solid]
+    if spec.kind == "FSI":
+        c0 = sound_speed_2d()
+        parts += [fluid_block_2d(PARTICLE_SPACING_2D[spec.resolution]),
+                  "coupling {\n"
+                  "  scheme: SERIAL_EXPLICIT\n"
+                  f"  # mu = 2 rho c dt / (rho_s t) = {2 * BLOOD_DENSITY * c0 * coupling_window(c0) / (LEAFLET_DENSITY * ValveParameters().thickness):.2f} (stable below 2)\n"
+                  f"  window_size: {coupling_window(c0):g}\n"
+                  "  mapping: NEAREST_PROJECTION\n"
+                  "}\n"]
+    return "".join(parts)
+
+
+def strip_depth_line() -> str:
+    return f"  strip_depth: {STRIP_DEPTH:g}\n"
+
+
+def write_2d(cases_dir: Path, meshes: bool = True) -> list[Path]:
+    written = []
+    for spec in all_specs_2d():
+        path = cases_dir / f"{spec.name}.textproto"
+        path.write_text(case_text_2d(spec))
+        written.append(path)
+    if meshes:
+        for resolution in SEGMENTS:
+            path = cases_dir / "meshes" / f"valve-2d-{resolution}.mesh.h5"
+            write_mesh(build_strip_mesh(resolution), path)
+            written.append(path)
+    return written
+
+
+def plot_scene(path: Path, resolution: str = "coarse") -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
+    ch = Channel2D()
+    lines = leaflet_polylines(ValveParameters(), SEGMENTS[resolution])
+    half = 0.5 * ch.width * 1e3
+    fig, ax = plt.subplots(figsize=(12, 3.2))
+    x0, x1 = -ch.upstream_length * 1e3, ch.downstream_length * 1e3
+    ax.plot([x0 - 5, x1 + 5], [half, half], "k-", [x0 - 5, x1 + 5], [-half, -half], "k-")
+    for y0 in (ch.stent_radius * 1e3, -half):
+        ax.add_patch(Rectangle((ch.stent_start * 1e3, y0), (ch.stent_end - ch.stent_start) * 1e3,
+                               half - ch.stent_radius * 1e3, color="0.6"))
+    for x, label in ((x0, "LV plate"), (x1, "Ao plate")):
+        ax.add_patch(Rectangle((x - 3 if x < 0 else x, -half), 3, 2 * half, color="tab:blue", alpha=0.5))
+        ax.text(x, half + 2, label, ha="center", fontsize=8)
+    for line in lines:
+        ax.plot(line[:, 0] * 1e3, line[:, 1] * 1e3, "o-", color="tab:orange", ms=2, lw=1.5)
+    for name, x in (("p", -ch.upstream_tap_distance), ("p", ch.downstream_tap_distance)):
+        ax.plot(x * 1e3, 0, "rv")
+    for x in ch.flow_sections:
+        ax.plot([x * 1e3] * 2, [-half, half], "g:", lw=0.8)
+    ax.plot([ch.velocity_probe_distance * 1e3] * 2, [-half, half], "m--", lw=0.8)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm, flow direction)")
+    ax.set_ylabel("y (mm)")
+    ax.set_title("2D valve scene: leaflets (orange), stent/gasket (grey), pressure taps (red), "
+                 "flow sections (green), velocity section (magenta)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description="Write the 2D valve's strip meshes and its FE-only and FSI case files.")
+    parser.add_argument("--cases-dir", type=Path, default=CASES_DIR)
+    parser.add_argument("--no-meshes", action="store_true", help="write only the case files")
+    parser.add_argument("--png", type=Path, help="optional sketch of the scene")
+    args = parser.parse_args(argv)
+    for path in write_2d(args.cases_dir, meshes=not args.no_meshes):
+        print(path)
+    if args.png:
+        plot_scene(args.png)
+    p = ValveParameters()
+    tips = [line[-1] for line in leaflet_polylines(p, SEGMENTS["coarse"])]
+    print(f"leaflet length {leaflet_length(p) * 1e3:.2f} mm, tip gap {abs(tips[0][1] - tips[1][1]) * 1e3:.3f} mm, "
+          f"c0 {sound_speed_2d():g} m/s, window {coupling_window(sound_speed_2d()) * 1e6:g} us")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,177 @@
+"""The 2D valve scene (issue 7, item 1): strip mesh invariants of the shared contract, geometry
+sanity in the channel, and the checked-in 2D case files."""
+import re
+import tempfile
+import unittest
+from pathlib import Path
+
+import numpy as np
+
+from valve_scene import valve2d
+from valve_scene.mesh_io import read_mesh, write_mesh
+from valve_scene.valve2d import (SEGMENTS, STRIP_DEPTH, Channel2D, all_specs_2d, build_strip_mesh,
+                                 case_text_2d, leaflet_length, leaflet_polylines)
+from valve_scene.valve_geometry import ValveParameters, leaflet_point
+
+CASES = Path(__file__).resolve().parents[2] / "cases"
+P = ValveParameters()
+
+
+def unit_normals(nodes, tris):
+    a, b, c = nodes[tris[:, 0]], nodes[tris[:, 1]], nodes[tris[:, 2]]
+    n = np.cross(b - a, c - a)
+    return n / np.linalg.norm(n, axis=1)[:, None]
+
+
+class StripMesh(unittest.TestCase):
+    def setUp(self):
+        self.meshes = {r: build_strip_mesh(r) for r in SEGMENTS}
+
+    def test_front_and_back_are_pairs_one_strip_depth_apart(self):
+        for r, mesh in self.meshes.items():
+            front, back = mesh.node_sets["strip_front"], mesh.node_sets["strip_back"]
+            self.assertEqual(len(front), 2 * (SEGMENTS[r] + 1))
+            self.assertEqual(len(front), len(back))
+            np.testing.assert_array_equal(mesh.nodes[front, 2], 0.0)
+            np.testing.assert_allclose(mesh.nodes[back] - mesh.nodes[front], np.tile([0, 0, STRIP_DEPTH], (len(front), 1)), atol=1e-15)
+            self.assertEqual(len(np.union1d(front, back)), len(mesh.nodes))
+
+    def test_two_triangles_per_segment_each_spanning_the_strip(self):
+        for r, mesh in self.meshes.items():
+            self.assertEqual(len(mesh.triangles), 2 * 2 * SEGMENTS[r])
+            z = mesh.nodes[mesh.triangles, 2]
+            # every triangle has nodes on both faces
+            self.assertTrue(np.all(z.min(axis=1) == 0.0) and np.all(z.max(axis=1) > 0.0))
+            area = 0.5 * np.linalg.norm(np.cross(*(mesh.nodes[mesh.triangles[:, k]] - mesh.nodes[mesh.triangles[:, 0]] for k in (1, 2))), axis=1)
+            for k in range(2):
+                ids = mesh.element_sets[f"leaflet_{k}_triangles"][1]
+                self.assertAlmostEqual(area[ids].sum(), STRIP_DEPTH * leaflet_length(P), delta=2e-3 * STRIP_DEPTH * leaflet_length(P))
+
+    def test_oriented_manifold_strips(self):
+        for mesh in self.meshes.values():
+            directed = [(t[i], t[(i + 1) % 3]) for t in mesh.triangles for i in range(3)]
+            self.assertEqual(len(directed), len(set(directed)))
+
+    def test_normals_point_to_the_outflow_side(self):
+        for mesh in self.meshes.values():
+            n = unit_normals(mesh.nodes, mesh.triangles)
+            for k, sign in ((0, 1.0), (1, -1.0)):
+                ids = mesh.element_sets[f"leaflet_{k}_triangles"][1]
+                # base (first segment) faces downstream; the hanging free end faces the stent (the sinus)
+                self.assertGreater(n[ids[0], 0], 0.5)
+                self.assertGreater(sign * n[ids[-1], 1], 0.5)
+                np.testing.assert_allclose(n[ids, 2], 0.0, atol=1e-12)
+
+    def test_axes_circumferential_out_of_plane_radial_along_the_polyline(self):
+        for r, mesh in self.meshes.items():
+            np.testing.assert_allclose(mesh.triangle_circumferential, np.tile([0, 0, 1.0], (len(mesh.triangles), 1)))
+            radial = mesh.triangle_radial
+            np.testing.assert_allclose(np.linalg.norm(radial, axis=1), 1.0, rtol=1e-12)
+            np.testing.assert_allclose(np.sum(radial * unit_normals(mesh.nodes, mesh.triangles), axis=1), 0.0, atol=1e-12)
+            # toward the free end: consecutive front nodes of leaflet 0
+            n = SEGMENTS[r] + 1
+            d = mesh.nodes[1, :2] - mesh.nodes[0, :2]
+            np.testing.assert_allclose(radial[0, :2], d / np.linalg.norm(d), rtol=1e-12)
+            self.assertEqual(len(mesh.triangle_thickness), len(mesh.triangles))
+            np.testing.assert_allclose(mesh.triangle_thickness, P.thickness)
+            self.assertEqual(n * 2, len(mesh.node_sets["strip_front"]))
+
+    def test_node_sets_of_the_contract(self):
+        for r, mesh in self.meshes.items():
+            n = SEGMENTS[r] + 1
+            count = 2 * n
+            self.assertEqual(sorted(mesh.node_sets["attachment"]), [0, n, count, count + n])
+            self.assertEqual(sorted(mesh.node_sets["free_edge"]), [n - 1, 2 * n - 1, count + n - 1, count + 2 * n - 1])
+            self.assertEqual(list(mesh.node_sets["free_edge_midpoints"]), [n - 1, 2 * n - 1])
+            for k in range(2):
+                ids = mesh.node_sets[f"leaflet_{k}"]
+                self.assertEqual(len(ids), 2 * n)
+                self.assertTrue(np.all(np.sign(mesh.nodes[ids, 1]) == (1 if k == 0 else -1)))
+
+    def test_file_round_trip(self):
+        mesh = self.meshes["coarse"]
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "v2d.mesh.h5"
+            write_mesh(mesh, path)
+            back = read_mesh(path)
+        np.testing.assert_array_equal(back.nodes, mesh.nodes)
+        np.testing.assert_array_equal(back.triangles, mesh.triangles)
+        self.assertEqual(back.description["variant"], "2d")
+        self.assertAlmostEqual(back.description["strip_depth"], STRIP_DEPTH)
+
+
+class Geometry(unittest.TestCase):
+    def test_leaflet_is_the_3d_belly_section(self):
+        line = leaflet_polylines(P, 200)[0]
+        base, tip = leaflet_point(P, 0.0, 0.0), leaflet_point(P, 0.0, 1.0)
+        np.testing.assert_allclose(line[0], [base[2], base[0]], atol=1e-15)
+        np.testing.assert_allclose(line[-1], [tip[2], tip[0]], atol=1e-15)
+        # uniform arc length, and the length is the section's
+        seg = np.linalg.norm(np.diff(line, axis=0), axis=1)
+        self.assertLess(seg.max() / seg.min() - 1, 1e-3)
+        self.assertAlmostEqual(seg.sum(), leaflet_length(P), delta=1e-6)
+        self.assertTrue(15e-3 < leaflet_length(P) < 18e-3)
+
+    def test_leaflets_inside_the_orifice_attached_on_the_stent_faces(self):
+        ch = Channel2D()
+        for r in SEGMENTS:
+            for k, line in enumerate(leaflet_polylines(P, SEGMENTS[r])):
+                sign = 1.0 if k == 0 else -1.0
+                self.assertAlmostEqual(line[0, 1], sign * ch.stent_radius, delta=1e-12)
+                self.assertTrue(ch.stent_start <= line[0, 0] <= ch.stent_end)
+                self.assertTrue(np.all(np.abs(line[:, 1]) <= ch.stent_radius + 1e-12))
+                self.assertTrue(np.all((line[:, 0] >= 0) & (line[:, 0] < ch.stent_end)))
+
+    def test_tips_nearly_meet_without_overlap(self):
+        upper, lower = leaflet_polylines(P, SEGMENTS["medium"])
+        self.assertTrue(np.all(upper[:, 1] > 0) and np.all(lower[:, 1] < 0))
+        gap = upper[-1, 1] - lower[-1, 1]
+        self.assertAlmostEqual(gap, P.coaptation_gap / np.sin(np.pi / 3), delta=1e-12)   # 0.577 mm
+        self.assertLess(gap, 1e-3)
+
+    def test_channel_parameters_are_checked(self):
+        with self.assertRaisesRegex(ValueError, "'upstream_tap_distance' = 0.2"):
+            Channel2D(upstream_tap_distance=0.2).validate()
+        with self.assertRaisesRegex(ValueError, "'width'"):
+            Channel2D(width=0.02).validate()
+
+    def test_sound_speed_and_coupling_window(self):
+        self.assertAlmostEqual(valve2d.peak_forward_velocity(), 1.57, delta=0.02)
+        self.assertEqual(valve2d.sound_speed_2d(), 20.0)
+        w = valve2d.coupling_window(20.0)
+        mu = 2 * valve2d.BLOOD_DENSITY * 20.0 * w / (valve2d.LEAFLET_DENSITY * P.thickness)
+        self.assertTrue(0.9 < mu <= 1.0)
+
+
+class CaseFiles2D(unittest.TestCase):
+    def test_checked_in_cases_are_current(self):
+        for spec in all_specs_2d():
+            with self.subTest(case=spec.name):
+                self.assertEqual((CASES / f"{spec.name}.textproto").read_text(), case_text_2d(spec))
+
+    def test_header_and_two_dimensional_fields(self):
+        for spec in all_specs_2d():
+            text = case_text_2d(spec)
+            comment = text[:text.index("\ntitle:")]
+            self.assertTrue(all(line.startswith("#") for line in comment.splitlines()))
+            self.assertIn("# What it models:", comment)
+            self.assertIn("# What it should show:", comment)
+            self.assertIn(f"scripts/run_case.py cases/{spec.name}.textproto", comment)
+            self.assertIn("dimension: 2", text)
+            self.assertIn(f'mesh_file: "meshes/valve-2d-{spec.resolution}.mesh.h5"', text)
+            if spec.kind == "FSI":
+                for vector in re.findall(r"(?:lower|upper|point|position|origin|axis|normal|domain_lower|domain_upper|lattice_origin): (\[[^\]]*\])", text):
+                    self.assertEqual(vector.count(",") + 1, 2, vector)
+
+    def test_stent_faces_and_plate_faces_on_lattice_planes(self):
+        ch = Channel2D()
+        for dp in valve2d.PARTICLE_SPACING_2D.values():
+            for face in (ch.stent_radius, -ch.stent_radius):
+                k = (face + ch.stent_radius) / dp
+                self.assertAlmostEqual(k, round(k), delta=1e-9)
+            for face in (ch.stent_start, ch.stent_end, -ch.upstream_length, ch.downstream_length):
+                self.assertAlmostEqual(face / dp, round(face / dp), delta=1e-9)
+
+
+if __name__ == "__main__":
+    unittest.main()

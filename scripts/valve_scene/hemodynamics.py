@@ -1,0 +1,407 @@
+"""Hemodynamics of an FSI run (issue 7, item 3), from the fluid's probe series and the coupler's
+interface series, per cardiac cycle, next to the reference's Table 2.
+
+    cd scripts && /usr/bin/python3 -m valve_scene.hemodynamics RUN_DIR [--cycle 2] \
+        [--model FSI-Ogden] [--markdown X.md] [--png X.png]
+
+Inputs (docs/fluid_sph.md, docs/coupling.md): RUN_DIR/fluid_probes.h5 (/time; /pressure/<tap>
+in Pa, gauge; /flow_rate/<section> in m^3/s, m^2/s in 2D; /max_velocity/<plane> in m/s;
+/wall_force/fixed_walls, samples x D) and RUN_DIR/coupling_series.h5 (/time = window end;
+/force_fluid, windows x 3, N or N/m in 2D: the fluid's force on the leaflets).
+
+Definitions (reference Sec. 2.4 and 3.3, after ISO 5840; written in docs/hemodynamics.md):
+- transvalvular pressure dP(t) = p(upstream tap) - p(downstream tap);
+- flow rate Q(t) = mean over the flow sections;
+- forward-flow period [t1, t2]: the interval around the cycle's peak flow where the flow,
+  smoothed by a centred moving average of `smoothing_s`, is positive (zero crossings
+  interpolated linearly);
+- MSPD = mean of dP over [t1, t2]; PSPD = max of dP over [t1, t2] (with its time);
+- Qrms = sqrt(mean of Q^2 over [t1, t2]); EOA = Qrms / (51.6 sqrt(MSPD)) with Q in mL/s and
+  dP in mmHg gives cm^2 (51.6 = sqrt(2 * 1333.2 dyn/cm^2 / 1 g/cm^3): Bernoulli's jet speed
+  in cm/s per sqrt(mmHg));
+- regurgitant volume = closing + leakage = -integral of Q from t2 to the cycle's end; the
+  closing part ends at valve closure: the first time after the backflow peak where the
+  smoothed flow has come back 90 % of the way from the peak to the leakage level (the median
+  of the smoothed flow over the last half of [t2, cycle end]), unless a closure time is given;
+- peak pull-out force: the maximum axial leaflet force over [t1, t2] (downstream positive);
+- peak diastolic force: the minimum axial leaflet force after t2; water-hammer ratio = its
+  magnitude over the hydrostatic force Pmax * A (Pmax the waveform's largest reverse
+  gradient, A the annulus area pi R^2; 2D: per metre of depth, A = 2 R x 1 m).
+In 2D every extensive quantity is per unit depth: Q in cm^2/s (mL/s per cm of depth), EOA in
+cm (cm^2 per cm: an effective orifice width), volumes in cm^2 (mL per cm), forces in N/m.
+"""
+from __future__ import annotations
+
+import argparse
+import functools
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import waveform
+
+PA_PER_MMHG = 133.322387415
+GORLIN_CONSTANT = 51.6        # cm/s per sqrt(mmHg), with Q in mL/s -> EOA in cm^2
+ANNULUS_RADIUS_M = 11.5e-3    # size 23
+
+# Reference Table 2 and Sec. 3.3 (W. Mao, K. Li, W. Sun, "Fluid-structure interaction study of
+# transcatheter aortic valve dynamics using smoothed particle hydrodynamics", Cardiovasc. Eng.
+# Technol. 7(4), 2016): times in s where the paper gives them.
+REFERENCE_HEMODYNAMICS = {
+    "FSI-Ogden": {"mspd_mmHg": 5.3, "pspd_mmHg": 14.5, "pspd_time_s": 0.025, "eoa": 1.22,
+                  "regurgitant_volume": 3.2, "peak_flow_L_per_min": 13.1, "peak_velocity_m_per_s": 1.40,
+                  "peak_velocity_time_s": 0.080, "pull_out_force": 0.26, "diastolic_force": -6.9,
+                  "diastolic_force_time_s": 0.270, "hydrostatic_force": -5.4},
+    "FSI-MHGO": {"mspd_mmHg": 5.0, "pspd_mmHg": 11.7, "pspd_time_s": 0.025, "eoa": 1.50,
+                 "regurgitant_volume": 3.1, "peak_flow_L_per_min": 14.7, "peak_velocity_m_per_s": 1.36,
+                 "peak_velocity_time_s": 0.080, "pull_out_force": 0.20, "diastolic_force": -6.1,
+                 "diastolic_force_time_s": 0.270, "hydrostatic_force": -5.4},
+}
+
+
+@dataclass
+class ProbeSeries:
+    """What the analysis needs, in SI units, on the fluid's sample times (and the coupler's)."""
+    time: np.ndarray                        # fluid probe sample times (s)
+    upstream_pressure: np.ndarray           # Pa (gauge)
+    downstream_pressure: np.ndarray         # Pa
+    flow_rates: dict                        # section name -> m^3/s (m^2/s in 2D)
+    max_velocity: np.ndarray | None         # m/s on the velocity plane, or None
+    dimension: int = 3
+    force_time: np.ndarray | None = None    # coupling window ends (s)
+    axial_force: np.ndarray | None = None   # N (N/m in 2D), downstream positive
+
+    @property
+    def mean_flow_rate(self) -> np.ndarray:
+        return np.mean(np.stack(list(self.flow_rates.values())), axis=0)
+
+    @property
+    def pressure_drop(self) -> np.ndarray:
+        return self.upstream_pressure - self.downstream_pressure
+
+
+@dataclass
+class CycleHemodynamics:
+    """One cycle's metrics in the reference's units (2D: per depth, see the module doc)."""
+    cycle: int
+    dimension: int
+    forward_start_s: float          # t1, within the cycle (s from its start)
+    forward_end_s: float            # t2
+    mspd_mmHg: float
+    pspd_mmHg: float
+    pspd_time_s: float
+    q_rms: float                    # mL/s (2D: cm^2/s)
+    eoa: float                      # cm^2 (2D: cm)
+    stroke_volume: float            # mL (2D: cm^2), forward-flow period
+    closing_volume: float           # mL (2D: cm^2)
+    leakage_volume: float
+    regurgitant_volume: float
+    closure_time_s: float
+    peak_flow: float                # mL/s (2D: cm^2/s)
+    peak_flow_L_per_min: float      # 3D only meaningful; 2D: L/min per metre... kept for the table
+    peak_velocity_m_per_s: float | None
+    peak_velocity_time_s: float | None
+    pull_out_force: float | None    # N (2D: N/m)
+    diastolic_force: float | None
+    diastolic_force_time_s: float | None
+    hydrostatic_force: float        # -Pmax * A, N (2D: N/m)
+    water_hammer_ratio: float | None
+    section_stroke_volumes: dict    # section -> forward volume over [t1, t2], mL (2D: cm^2)
+
+
+def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "downstream_tap",
+             velocity_plane: str | None = None) -> ProbeSeries:
+    """Reads RUN_DIR/fluid_probes.h5 and, if present, RUN_DIR/coupling_series.h5."""
+    import h5py
+    run_dir = Path(run_dir)
+    path = run_dir / "fluid_probes.h5"
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: no fluid probe series (fluid_sph writes it in its output folder)")
+    with h5py.File(path, "r") as f:
+        for group, field in (("pressure", "pressure_points"), ("flow_rate", "flow_planes")):
+            if group not in f:
+                raise ValueError(f"{path}: no group '/{group}': the case needs fluid.probes.{field}")
+        for name in (upstream, downstream):
+            if name not in f["pressure"]:
+                raise ValueError(f"{path}: no dataset '/pressure/{name}': have {', '.join(f['pressure'])}")
+        flows = {name: f["flow_rate"][name][()].reshape(-1) for name in f["flow_rate"]}
+        if not flows:
+            raise ValueError(f"{path}: '/flow_rate' holds no section")
+        velocity = None
+        if "max_velocity" in f and len(f["max_velocity"]):
+            names = list(f["max_velocity"])
+            name = velocity_plane or names[0]
+            if name not in names:
+                raise ValueError(f"{path}: no dataset '/max_velocity/{name}': have {', '.join(names)}")
+            velocity = f["max_velocity"][name][()].reshape(-1)
+        dimension = 3
+        if "wall_force" in f and "fixed_walls" in f["wall_force"]:
+            dimension = int(f["wall_force"]["fixed_walls"].shape[1])
+        series = ProbeSeries(time=f["time"][()].reshape(-1),
+                             upstream_pressure=f["pressure"][upstream][()].reshape(-1),
+                             downstream_pressure=f["pressure"][downstream][()].reshape(-1),
+                             flow_rates=flows, max_velocity=velocity, dimension=dimension)
+    coupling = run_dir / "coupling_series.h5"
+    if coupling.exists():
+        with h5py.File(coupling, "r") as f:
+            if "force_fluid" in f and len(f["time"]):
+                axis = 2 if series.dimension == 3 else 0
+                series.force_time = f["time"][()].reshape(-1)
+                series.axial_force = f["force_fluid"][()][:, axis]
+    return series
+
+
+def moving_average(t: np.ndarray, y: np.ndarray, width_s: float) -> np.ndarray:
+    """Centred moving average over about width_s (uniform sampling assumed; none if shorter)."""
+    if len(t) < 3 or width_s <= 0:
+        return y.copy()
+    dt = float(np.median(np.diff(t)))
+    n = int(round(width_s / dt))
+    if n < 2:
+        return y.copy()
+    kernel = np.ones(n) / n
+    padded = np.concatenate([np.full(n, y[0]), y, np.full(n, y[-1])])
+    return np.convolve(padded, kernel, mode="same")[n:-n]
+
+
+def _crossing(t, y, i0, i1) -> float:
+    """Zero of the line through (t[i0], y[i0]) and (t[i1], y[i1])."""
+    if y[i1] == y[i0]:
+        return float(t[i1])
+    return float(t[i0] + (t[i1] - t[i0]) * (0.0 - y[i0]) / (y[i1] - y[i0]))
+
+
+def integral(t: np.ndarray, y: np.ndarray, a: float, b: float) -> float:
+    """Trapezoidal integral of the piecewise-linear y(t) over [a, b] (ends interpolated)."""
+    if b <= a:
+        return 0.0
+    inside = (t > a) & (t < b)
+    tt = np.concatenate([[a], t[inside], [b]])
+    yy = np.concatenate([[np.interp(a, t, y)], y[inside], [np.interp(b, t, y)]])
+    return float(np.sum(0.5 * (yy[1:] + yy[:-1]) * np.diff(tt)))
+
+
+def forward_flow_period(t: np.ndarray, q_smooth: np.ndarray) -> tuple[float, float]:
+    """[t1, t2] around the peak flow where the smoothed flow is positive."""
+    peak = int(np.argmax(q_smooth))
+    if q_smooth[peak] <= 0:
+        raise ValueError("no forward flow in the analysed cycle (flow rate never positive)")
+    i = peak
+    while i > 0 and q_smooth[i - 1] > 0:
+        i -= 1
+    t1 = float(t[0]) if i == 0 else _crossing(t, q_smooth, i - 1, i)
+    j = peak
+    while j < len(t) - 1 and q_smooth[j + 1] > 0:
+        j += 1
+    t2 = float(t[-1]) if j == len(t) - 1 else _crossing(t, q_smooth, j, j + 1)
+    return t1, t2
+
+
+def closure_time(t: np.ndarray, q_smooth: np.ndarray, t2: float) -> float:
+    """End of the closing backflow (module doc): 90 % back from the backflow peak to the
+    leakage level."""
+    after = t >= t2
+    ta, qa = t[after], q_smooth[after]
+    if len(ta) < 4:
+        return float(t[-1])
+    late = ta >= t2 + 0.5 * (ta[-1] - t2)
+    leak_level = float(np.median(qa[late]))
+    k = int(np.argmin(qa))
+    if qa[k] >= leak_level:   # no backflow peak below the leakage level
+        return float(t2)
+    target = qa[k] + 0.9 * (leak_level - qa[k])
+    for m in range(k, len(ta)):
+        if qa[m] >= target:
+            if m == k:
+                return float(ta[m])
+            return float(ta[m - 1] + (ta[m] - ta[m - 1]) * (target - qa[m - 1]) / (qa[m] - qa[m - 1]))
+    return float(ta[-1])
+
+
+@functools.lru_cache(maxsize=None)
+def hydrostatic_pressure_Pa() -> float:
+    """The waveform's largest reverse transvalvular gradient (Pa, positive): 97.2 mmHg."""
+    t = np.linspace(0.0, waveform.PERIOD_S, 8001)
+    return -float(np.min(waveform.transvalvular_pressure_mmHg(t))) * PA_PER_MMHG
+
+
+def annulus_area(dimension: int, radius: float = ANNULUS_RADIUS_M) -> float:
+    """m^2 (3D: pi R^2) or m^2 per metre of depth (2D: the orifice width 2R)."""
+    return math.pi * radius ** 2 if dimension == 3 else 2.0 * radius
+
+
+def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.PERIOD_S,
+                  smoothing_s: float = 0.002, closure_time_s: float | None = None,
+                  hydrostatic_Pa: float | None = None, annulus_radius: float = ANNULUS_RADIUS_M) -> CycleHemodynamics:
+    """Metrics of cycle `cycle` (1-based: [(cycle-1) T, cycle T)). closure_time_s, if given, is
+    the valve's closure within the cycle (e.g. from the kinematics) and splits closing from
+    leakage volume."""
+    start, end = (cycle - 1) * period, cycle * period
+    t_all = series.time
+    sel = (t_all >= start - 1e-12) & (t_all <= end + 1e-12)
+    if np.count_nonzero(sel) < 4:
+        raise ValueError(f"cycle {cycle} ([{start:g}, {end:g}] s) has {np.count_nonzero(sel)} probe samples: "
+                         f"the series covers [{t_all[0]:g}, {t_all[-1]:g}] s")
+    t = t_all[sel]
+    if t[-1] < end - 0.05 * period:
+        raise ValueError(f"cycle {cycle} is incomplete: the series ends at {t[-1]:g} s, the cycle at {end:g} s")
+    q = series.mean_flow_rate[sel]
+    dp = series.pressure_drop[sel]
+    q_s = moving_average(t, q, smoothing_s)
+    t1, t2 = forward_flow_period(t, q_s)
+    duration = t2 - t1
+    # Volumes: m^3 -> mL is 1e6 (3D); m^2 -> cm^2 is 1e4 (2D, per depth). Rates likewise.
+    to_volume = 1e6 if series.dimension == 3 else 1e4
+    mspd = integral(t, dp, t1, t2) / duration / PA_PER_MMHG
+    in_forward = (t >= t1) & (t <= t2)
+    k = int(np.argmax(np.where(in_forward, dp, -np.inf)))
+    q_rms = math.sqrt(integral(t, q * q, t1, t2) / duration) * to_volume
+    eoa = q_rms / (GORLIN_CONSTANT * math.sqrt(mspd)) if mspd > 0 else float("nan")
+    t_close = closure_time(t, q_s, t2) if closure_time_s is None else start + closure_time_s
+    closing = -integral(t, q, t2, t_close) * to_volume
+    leakage = -integral(t, q, t_close, t[-1]) * to_volume
+    peak_q = float(np.max(q)) * to_volume
+    sections = {name: integral(t, rate[sel], t1, t2) * to_volume for name, rate in series.flow_rates.items()}
+
+    velocity = velocity_time = None
+    if series.max_velocity is not None:
+        v = series.max_velocity[sel]
+        kv = int(np.argmax(v))
+        velocity, velocity_time = float(v[kv]), float(t[kv] - start)
+    p_max = hydrostatic_Pa if hydrostatic_Pa is not None else hydrostatic_pressure_Pa()
+    hydrostatic_force = -p_max * annulus_area(series.dimension, annulus_radius)
+    pull_out = diastolic = diastolic_time = ratio = None
+    if series.axial_force is not None and series.force_time is not None:
+        tf, f = series.force_time, series.axial_force
+        systole = (tf >= t1) & (tf <= t2)
+        diastole = (tf > t2) & (tf <= end + 1e-12)
+        if np.any(systole):
+            pull_out = float(np.max(f[systole]))
+        if np.any(diastole):
+            kd = int(np.argmin(np.where(diastole, f, np.inf)))
+            diastolic, diastolic_time = float(f[kd]), float(tf[kd] - start)
+            ratio = diastolic / hydrostatic_force
+    return CycleHemodynamics(
+        cycle=cycle, dimension=series.dimension, forward_start_s=t1 - start, forward_end_s=t2 - start,
+        mspd_mmHg=mspd, pspd_mmHg=float(dp[k]) / PA_PER_MMHG, pspd_time_s=float(t[k] - start),
+        q_rms=q_rms, eoa=eoa, stroke_volume=integral(t, q, t1, t2) * to_volume,
+        closing_volume=closing, leakage_volume=leakage, regurgitant_volume=closing + leakage,
+        closure_time_s=t_close - start, peak_flow=peak_q, peak_flow_L_per_min=peak_q * 60.0 / 1000.0,
+        peak_velocity_m_per_s=velocity, peak_velocity_time_s=velocity_time,
+        pull_out_force=pull_out, diastolic_force=diastolic, diastolic_force_time_s=diastolic_time,
+        hydrostatic_force=hydrostatic_force, water_hammer_ratio=ratio, section_stroke_volumes=sections)
+
+
+# ---------------------------------------------------------------------------------------------
+# Report
+
+
+def _units(dimension: int) -> dict:
+    if dimension == 3:
+        return {"eoa": "cm²", "volume": "mL", "flow": "mL/s", "force": "N", "flow_min": "L/min"}
+    return {"eoa": "cm per cm depth", "volume": "cm² (mL per cm depth)", "flow": "cm²/s",
+            "force": "N/m", "flow_min": "L/min per cm depth"}
+
+
+def _f(value, digits=2, scale=1.0) -> str:
+    return "–" if value is None or (isinstance(value, float) and math.isnan(value)) else f"{value * scale:.{digits}f}"
+
+
+def hemodynamics_table(results: dict) -> str:
+    """Markdown table: one column per model (name -> CycleHemodynamics), then the reference's
+    FSI columns (3D values; in 2D only the dimensionless rows and the times compare)."""
+    models = list(results)
+    dims = {r.dimension for r in results.values()}
+    u = _units(dims.pop() if len(dims) == 1 else 3)
+    refs = list(REFERENCE_HEMODYNAMICS)
+    header = "| quantity | " + " | ".join(f"{m} (ours)" for m in models) + " | " + " | ".join(f"{r} (ref.)" for r in refs) + " |"
+    rows = [header, "|---" * (1 + len(models) + len(refs)) + "|"]
+
+    def ref(key, digits=2, scale=1.0):
+        return [_f(REFERENCE_HEMODYNAMICS[r].get(key), digits, scale) for r in refs]
+
+    def ref_ratio(r):
+        d = REFERENCE_HEMODYNAMICS[r]
+        return f"{d['diastolic_force'] / d['hydrostatic_force']:.2f}"
+
+    spec = [
+        ("MSPD (mmHg)", lambda r: _f(r.mspd_mmHg, 1), ref("mspd_mmHg", 1)),
+        ("PSPD (mmHg)", lambda r: _f(r.pspd_mmHg, 1), ref("pspd_mmHg", 1)),
+        ("PSPD time (ms)", lambda r: _f(r.pspd_time_s, 0, 1e3), ref("pspd_time_s", 0, 1e3)),
+        (f"EOA ({u['eoa']})", lambda r: _f(r.eoa, 2), ref("eoa", 2)),
+        (f"regurgitant volume ({u['volume']})", lambda r: _f(r.regurgitant_volume, 2), ref("regurgitant_volume", 1)),
+        (f"— closing ({u['volume']})", lambda r: _f(r.closing_volume, 2), ["–"] * len(refs)),
+        (f"— leakage ({u['volume']})", lambda r: _f(r.leakage_volume, 2), ["–"] * len(refs)),
+        (f"peak flow rate ({u['flow_min']})", lambda r: _f(r.peak_flow_L_per_min, 2), ref("peak_flow_L_per_min", 1)),
+        ("peak velocity 15 mm downstream (m/s)", lambda r: _f(r.peak_velocity_m_per_s, 2), ref("peak_velocity_m_per_s", 2)),
+        ("peak velocity time (ms)", lambda r: _f(r.peak_velocity_time_s, 0, 1e3), ref("peak_velocity_time_s", 0, 1e3)),
+        (f"peak pull-out force, systole ({u['force']})", lambda r: _f(r.pull_out_force, 3), ref("pull_out_force", 2)),
+        (f"peak diastolic force ({u['force']})", lambda r: _f(r.diastolic_force, 2), ref("diastolic_force", 1)),
+        ("diastolic force time (ms)", lambda r: _f(r.diastolic_force_time_s, 0, 1e3), ref("diastolic_force_time_s", 0, 1e3)),
+        (f"hydrostatic force Pmax·A ({u['force']})", lambda r: _f(r.hydrostatic_force, 2), ref("hydrostatic_force", 1)),
+        ("water-hammer ratio", lambda r: _f(r.water_hammer_ratio, 2), [ref_ratio(r) for r in refs]),
+        ("forward flow (ms)", lambda r: f"{r.forward_start_s * 1e3:.0f}–{r.forward_end_s * 1e3:.0f}", ["–"] * len(refs)),
+    ]
+    for label, ours, theirs in spec:
+        rows.append(f"| {label} | " + " | ".join(ours(results[m]) for m in models) + " | " + " | ".join(theirs) + " |")
+    return "\n".join(rows) + "\n"
+
+
+def plot_cycle(series: ProbeSeries, result: CycleHemodynamics, path: Path, period: float = waveform.PERIOD_S) -> None:
+    """Like the reference's Fig. 11: pressure drop, flow rate, axial leaflet force and maximum
+    velocity over the analysed cycle."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    start = (result.cycle - 1) * period
+    sel = (series.time >= start) & (series.time <= start + period)
+    t = (series.time[sel] - start) * 1e3
+    u = _units(series.dimension)
+    to_volume = 1e6 if series.dimension == 3 else 1e4
+    fig, axes = plt.subplots(4, 1, figsize=(7, 9), sharex=True)
+    axes[0].plot(t, series.pressure_drop[sel] / PA_PER_MMHG, "k-", lw=0.8)
+    axes[0].set_ylabel("ΔP (mmHg)")
+    axes[1].plot(t, series.mean_flow_rate[sel] * to_volume, "b-", lw=0.8)
+    axes[1].set_ylabel(f"Q ({u['flow']})")
+    if series.axial_force is not None:
+        fs = (series.force_time >= start) & (series.force_time <= start + period)
+        axes[2].plot((series.force_time[fs] - start) * 1e3, series.axial_force[fs], "r-", lw=0.8)
+        axes[2].axhline(result.hydrostatic_force, color="0.5", ls="--", lw=0.8, label="hydrostatic Pmax·A")
+        axes[2].legend(fontsize=8)
+    axes[2].set_ylabel(f"axial force ({u['force']})")
+    if series.max_velocity is not None:
+        axes[3].plot(t, series.max_velocity[sel], "g-", lw=0.8)
+    axes[3].set_ylabel("max speed 15 mm (m/s)")
+    axes[3].set_xlabel(f"time in cycle {result.cycle} (ms)")
+    for ax in axes:
+        ax.axvspan(result.forward_start_s * 1e3, result.forward_end_s * 1e3, color="y", alpha=0.15)
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description="Hemodynamics of an FSI run (fluid_probes.h5, coupling_series.h5).")
+    parser.add_argument("run_dir", type=Path)
+    parser.add_argument("--cycle", type=int, default=2, help="cycle analysed (1-based; default 2)")
+    parser.add_argument("--model", default="this run", help="column name in the table, e.g. FSI-Ogden")
+    parser.add_argument("--closure-time", type=float, help="valve closure within the cycle (s), e.g. from the kinematics")
+    parser.add_argument("--markdown", type=Path, help="write the table here")
+    parser.add_argument("--png", type=Path, help="write the Fig. 11-like plot here")
+    args = parser.parse_args(argv)
+    series = read_run(args.run_dir)
+    result = analyse_cycle(series, args.cycle, closure_time_s=args.closure_time)
+    table = hemodynamics_table({args.model: result})
+    print(table)
+    print("section stroke volumes:", {k: round(v, 3) for k, v in result.section_stroke_volumes.items()})
+    if args.markdown:
+        args.markdown.write_text(table)
+    if args.png:
+        plot_cycle(series, result, args.png)
+
+
+if __name__ == "__main__":
+    main()

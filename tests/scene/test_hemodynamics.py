@@ -1,0 +1,206 @@
+"""Hemodynamics (issue 7, item 3) on synthetic probe series with known answers: a half-sine
+ejection (known rms and volume), a known pressure drop, a closing backflow plus a constant
+leak (known regurgitant volume), a known leaflet force, two cycles, 2D units, and the HDF5
+layouts of fluid_sph and the coupler."""
+import math
+import tempfile
+import unittest
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from valve_scene import hemodynamics as hd
+
+MMHG = hd.PA_PER_MMHG
+T = 0.8            # period (s)
+TE = 0.25          # ejection (forward flow) duration (s)
+TC = 0.04          # closing backflow duration (s)
+QMAX = 250e-6      # m^3/s peak forward flow (15 L/min)
+A_BACK = 40e-6     # m^3/s closing backflow amplitude
+Q_LEAK = 2e-6      # m^3/s leak through the closed valve
+DT = 1e-4
+
+
+def flow(t, scale=1.0):
+    tau = np.mod(t, T)
+    q = np.zeros_like(tau)
+    fwd = tau <= TE
+    q[fwd] = scale * QMAX * np.sin(np.pi * tau[fwd] / TE)
+    s = tau - TE
+    closing = (s > 0) & (s <= TC)
+    # closing backflow rising from 0 into the leak level: -A sin(pi s / TC) - Q_LEAK s / TC
+    q[closing] = -A_BACK * np.sin(np.pi * s[closing] / TC) - Q_LEAK * s[closing] / TC
+    q[s > TC] = -Q_LEAK
+    return q
+
+
+def pressure_drop(t):
+    """5 + 3 sin^2 mmHg during ejection (mean 6.5, peak 8 at TE/2), -80 mmHg after."""
+    tau = np.mod(t, T)
+    return np.where(tau <= TE, 5.0 + 3.0 * np.sin(np.pi * tau / TE) ** 2, -80.0) * MMHG
+
+
+def axial_force(t):
+    """0.25 N pull-out peak at TE/2; a -7 N diastolic spike at 270 ms (width 10 ms) over a
+    -5 N plateau."""
+    tau = np.mod(t, T)
+    f = np.where(tau <= TE, 0.25 * np.sin(np.pi * tau / TE), -5.0 * (1 - np.exp(-(tau - TE) / 0.005)))
+    return f - 2.0 * np.exp(-0.5 * ((tau - 0.27) / 0.005) ** 2) * (tau > TE)
+
+
+def synthetic(cycles=2, dimension=3, first_cycle_scale=1.0, noise=0.0):
+    t = np.arange(int(round(cycles * T / DT)) + 1) * DT
+    scale = np.where(t < T, first_cycle_scale, 1.0)
+    q = flow(t) * scale
+    if noise:
+        q = q + noise * QMAX * np.sin(2 * np.pi * 2000.0 * t + 0.3)
+    p_down = 100 * MMHG + 0 * t
+    tf = np.arange(int(round(cycles * T / 2e-5)) + 1) * 2e-5
+    return hd.ProbeSeries(time=t, upstream_pressure=p_down + pressure_drop(t), downstream_pressure=p_down,
+                          flow_rates={"a": 1.1 * q, "b": 0.9 * q}, max_velocity=1.4 * np.sin(np.pi * np.clip(np.mod(t, T), 0, TE) / TE) ** 2,
+                          dimension=dimension, force_time=tf, axial_force=axial_force(tf))
+
+
+class Ejection(unittest.TestCase):
+    def setUp(self):
+        self.r = hd.analyse_cycle(synthetic(), cycle=2, smoothing_s=0.0)
+
+    def test_forward_flow_period_is_the_half_sine(self):
+        self.assertAlmostEqual(self.r.forward_start_s, 0.0, delta=1e-9)
+        self.assertAlmostEqual(self.r.forward_end_s, TE, delta=1e-6)
+
+    def test_rms_flow_of_a_half_sine(self):
+        self.assertAlmostEqual(self.r.q_rms, QMAX / math.sqrt(2) * 1e6, delta=1e-6 * QMAX * 1e6)
+        self.assertAlmostEqual(self.r.stroke_volume, 2 * QMAX * TE / math.pi * 1e6, delta=1e-5)
+        self.assertAlmostEqual(self.r.peak_flow_L_per_min, QMAX * 6e4, delta=1e-6)
+
+    def test_mean_and_peak_pressure_drop(self):
+        self.assertAlmostEqual(self.r.mspd_mmHg, 6.5, delta=1e-5)
+        self.assertAlmostEqual(self.r.pspd_mmHg, 8.0, delta=1e-5)
+        self.assertAlmostEqual(self.r.pspd_time_s, TE / 2, delta=DT)
+
+    def test_eoa_is_gorlins(self):
+        expected = QMAX / math.sqrt(2) * 1e6 / (51.6 * math.sqrt(6.5))   # 1.34 cm^2
+        self.assertAlmostEqual(self.r.eoa, expected, delta=1e-5)
+        self.assertTrue(1.3 < self.r.eoa < 1.45)
+
+    def test_flow_is_averaged_over_the_sections(self):
+        volume = 2 * QMAX * TE / math.pi * 1e6
+        self.assertAlmostEqual(self.r.section_stroke_volumes["a"], 1.1 * volume, delta=1e-5)
+        self.assertAlmostEqual(self.r.section_stroke_volumes["b"], 0.9 * volume, delta=1e-5)
+
+    def test_peak_velocity_and_its_time(self):
+        self.assertAlmostEqual(self.r.peak_velocity_m_per_s, 1.4, delta=1e-6)
+        self.assertAlmostEqual(self.r.peak_velocity_time_s, TE / 2, delta=DT)
+
+
+class Regurgitation(unittest.TestCase):
+    def test_regurgitant_volume_is_closing_plus_leakage(self):
+        r = hd.analyse_cycle(synthetic(), cycle=2, smoothing_s=0.0)
+        closing = (2 * A_BACK * TC / math.pi + 0.5 * Q_LEAK * TC) * 1e6
+        leakage = Q_LEAK * (T - TE - TC) * 1e6
+        # exact up to the trapezoid over the sampled jump back to forward flow (half a sample of leak)
+        self.assertAlmostEqual(r.regurgitant_volume, closing + leakage, delta=Q_LEAK * DT * 1e6)
+        # the closure instant (90 % back to the leak level) falls just before TE + TC
+        self.assertTrue(TE + 0.8 * TC < r.closure_time_s <= TE + TC)
+        self.assertAlmostEqual(r.closing_volume, closing, delta=0.02 * closing)
+
+    def test_given_closure_time_splits_exactly(self):
+        r = hd.analyse_cycle(synthetic(), cycle=2, smoothing_s=0.0, closure_time_s=TE + TC)
+        self.assertAlmostEqual(r.closing_volume, (2 * A_BACK * TC / math.pi + 0.5 * Q_LEAK * TC) * 1e6, delta=1e-5)
+        self.assertAlmostEqual(r.leakage_volume, Q_LEAK * (T - TE - TC) * 1e6, delta=Q_LEAK * DT * 1e6)
+
+
+class Forces(unittest.TestCase):
+    def test_pull_out_diastolic_peak_and_water_hammer_ratio(self):
+        r = hd.analyse_cycle(synthetic(), cycle=2, smoothing_s=0.0)
+        self.assertAlmostEqual(r.pull_out_force, 0.25, delta=1e-6)
+        expected_peak = -5.0 * (1 - math.exp(-0.02 / 0.005)) - 2.0
+        self.assertAlmostEqual(r.diastolic_force, expected_peak, delta=0.01)
+        self.assertAlmostEqual(r.diastolic_force_time_s, 0.27, delta=0.002)
+        # hydrostatic: 97.2 mmHg on the size-23 annulus = 5.39 N (docs/valve-scene.md)
+        self.assertAlmostEqual(r.hydrostatic_force, -5.39, delta=0.01)
+        self.assertAlmostEqual(r.water_hammer_ratio, r.diastolic_force / r.hydrostatic_force, delta=1e-12)
+        self.assertAlmostEqual(r.water_hammer_ratio, 6.93 / 5.39, delta=0.01)
+
+    def test_reference_ratio_in_the_table(self):
+        table = hd.hemodynamics_table({"synthetic": hd.analyse_cycle(synthetic(), smoothing_s=0.0)})
+        self.assertIn("| water-hammer ratio | 1.28 | 1.28 | 1.13 |", table)
+        self.assertIn("| EOA (cm²) | 1.34 | 1.22 | 1.50 |", table)
+
+
+class Cycles(unittest.TestCase):
+    def test_each_cycle_is_analysed_on_its_own(self):
+        series = synthetic(first_cycle_scale=0.5)
+        first = hd.analyse_cycle(series, cycle=1, smoothing_s=0.0)
+        second = hd.analyse_cycle(series, cycle=2, smoothing_s=0.0)
+        self.assertAlmostEqual(first.q_rms / second.q_rms, 0.5, delta=1e-6)
+
+    def test_incomplete_cycle_is_refused(self):
+        series = synthetic(cycles=1.5)
+        with self.assertRaisesRegex(ValueError, "cycle 2 is incomplete: the series ends at 1.2 s"):
+            hd.analyse_cycle(series, cycle=2)
+
+    def test_noise_does_not_break_the_forward_period(self):
+        # a 2 kHz ripple of 5 % of the peak (SPH-like) crosses zero many times near the ends
+        r = hd.analyse_cycle(synthetic(noise=0.05), cycle=2, smoothing_s=0.002)
+        self.assertAlmostEqual(r.forward_start_s, 0.0, delta=0.002)
+        self.assertAlmostEqual(r.forward_end_s, TE, delta=0.002)
+        self.assertAlmostEqual(r.q_rms, math.sqrt(0.5 * QMAX ** 2 + 0.5 * (0.05 * QMAX) ** 2) * 1e6, delta=0.01 * QMAX * 1e6)
+
+
+class TwoDimensional(unittest.TestCase):
+    def test_per_depth_units(self):
+        r3 = hd.analyse_cycle(synthetic(dimension=3), smoothing_s=0.0)
+        r2 = hd.analyse_cycle(synthetic(dimension=2), smoothing_s=0.0)
+        # the same numbers read as m^2/s per metre depth: cm^2/s, i.e. 1e4 instead of 1e6
+        self.assertAlmostEqual(r2.q_rms, r3.q_rms * 1e-2, delta=1e-9)
+        self.assertAlmostEqual(r2.regurgitant_volume, r3.regurgitant_volume * 1e-2, delta=1e-9)
+        self.assertAlmostEqual(r2.eoa, r3.eoa * 1e-2, delta=1e-9)
+        # hydrostatic force per metre of depth on the 23 mm orifice: 97.2 mmHg x 0.023 m
+        self.assertAlmostEqual(r2.hydrostatic_force, -hd.hydrostatic_pressure_Pa() * 0.023, delta=1e-9)
+        self.assertAlmostEqual(r2.hydrostatic_force, -298.1, delta=0.5)
+        self.assertIn("cm per cm depth", hd.hemodynamics_table({"2D": r2}))
+
+
+class Files(unittest.TestCase):
+    def write_run(self, folder: Path, series: hd.ProbeSeries):
+        with h5py.File(folder / "fluid_probes.h5", "w") as f:
+            f["time"] = series.time.reshape(-1, 1)
+            f["pressure/upstream_tap"] = series.upstream_pressure.reshape(-1, 1)
+            f["pressure/downstream_tap"] = series.downstream_pressure.reshape(-1, 1)
+            for name, q in series.flow_rates.items():
+                f[f"flow_rate/{name}"] = q.reshape(-1, 1)
+            f["max_velocity/15mm_downstream"] = series.max_velocity.reshape(-1, 1)
+            f["wall_force/fixed_walls"] = np.zeros((len(series.time), series.dimension))
+        with h5py.File(folder / "coupling_series.h5", "w") as f:
+            f["time"] = series.force_time
+            force = np.zeros((len(series.force_time), 3))
+            force[:, 2 if series.dimension == 3 else 0] = series.axial_force
+            f["force_fluid"] = force
+
+    def test_read_run_gives_the_in_memory_answer(self):
+        for dimension in (2, 3):
+            series = synthetic(dimension=dimension)
+            with tempfile.TemporaryDirectory() as tmp:
+                self.write_run(Path(tmp), series)
+                read = hd.read_run(Path(tmp))
+                self.assertEqual(read.dimension, dimension)
+                a = hd.analyse_cycle(read, smoothing_s=0.0)
+                png = Path(tmp) / "fig11.png"
+                hd.plot_cycle(read, a, png)
+                self.assertGreater(png.stat().st_size, 10000)
+            b = hd.analyse_cycle(series, smoothing_s=0.0)
+            self.assertAlmostEqual(a.eoa, b.eoa, delta=1e-12)
+            self.assertAlmostEqual(a.diastolic_force, b.diastolic_force, delta=1e-12)
+
+    def test_missing_tap_is_named(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            self.write_run(Path(tmp), synthetic())
+            with self.assertRaisesRegex(ValueError, "no dataset '/pressure/inlet': have downstream_tap, upstream_tap"):
+                hd.read_run(Path(tmp), upstream="inlet")
+
+
+if __name__ == "__main__":
+    unittest.main()

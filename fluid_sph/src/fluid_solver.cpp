@@ -27,33 +27,140 @@ void check_settings(const FluidSettings<D>& s) {
 }  // namespace
 
 template <int D>
-FluidSolver<D>::FluidSolver(const FluidSettings<D>& settings, Particles<D> particles, std::vector<PressurePlate<D>> plates)
+struct FluidSolver<D>::Checkpoint {
+  Particles<D> particles;
+  std::vector<PressurePlate<D>> plates;
+  std::vector<Vec<D>> body_forces, body_acceleration;
+  double time = 0.0, dt = 0.0;
+  long steps = 0;
+  std::size_t lost = 0, lost_density = 0;
+  float max_speed = 0.0f, max_acceleration = 0.0f;
+};
+
+template <int D>
+FluidSolver<D>::FluidSolver(const FluidSettings<D>& settings, Particles<D> particles, std::vector<PressurePlate<D>> plates,
+                            std::unique_ptr<ImmersedSurfaceModel<D>> surface)
     : settings_((check_settings(settings), settings)),
       particles_(std::move(particles)),
       plates_(std::move(plates)),
       grid_(settings.domain_lower, settings.domain_upper, settings.support_radius(), settings.periodic),
       body_forces_(plates_.size() + 1, Vec<D>{}),
-      body_acceleration_(plates_.size() + 1, Vec<D>{}) {
+      body_acceleration_(plates_.size() + 1, Vec<D>{}),
+      surface_(std::move(surface)) {
   for (std::size_t i = 0; i < particles_.size(); ++i)
     if (particles_.body[i] > plates_.size())
       throw std::invalid_argument("fluid particles: body index " + std::to_string(particles_.body[i]) +
                                   " has no pressure plate (plates: " + std::to_string(plates_.size()) + ")");
   lost_ = grid_.wrap_and_mark_lost(particles_);
   grid_.sort(particles_);
+  if (surface_) classify_surface();
   evaluate_rates();
   choose_time_step();
 }
 
 template <int D>
+void FluidSolver<D>::set_immersed_surface(std::unique_ptr<ImmersedSurfaceModel<D>> surface) {
+  surface_ = std::move(surface);
+  near_surface_.clear();
+  surface_force_sum_.clear();
+  surface_force_time_ = 0.0;
+  if (surface_) classify_surface();
+  evaluate_rates();
+  if (steps_ == 0) choose_time_step();
+}
+
+template <int D>
+void FluidSolver<D>::classify_surface() {
+  surface_->classify(particles_);
+  near_surface_.resize(particles_.size());
+  const auto n = static_cast<std::ptrdiff_t>(particles_.size());
+  const ImmersedSurfaceModel<D>& model = *surface_;
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t i = 0; i < n; ++i)
+    near_surface_[static_cast<std::size_t>(i)] = model.near_surface(static_cast<std::size_t>(i)) ? 1 : 0;
+}
+
+template <int D>
+PairFilter<D> FluidSolver<D>::pair_filter() const {
+  if (!surface_) return {};
+  return PairFilter<D>{surface_.get(), &particles_, near_surface_.data()};
+}
+
+template <int D>
+void FluidSolver<D>::reset_surface_force_average() {
+  surface_force_sum_.assign(surface_ ? surface_->node_count() : 0, Vec<D>{});
+  surface_force_time_ = 0.0;
+}
+
+template <int D>
+std::vector<Vec<D>> FluidSolver<D>::surface_force_average() const {
+  if (!surface_) return {};
+  std::vector<Vec<D>> average(surface_->node_count(), Vec<D>{});
+  if (surface_force_time_ > 0 && surface_force_sum_.size() == average.size()) {
+    for (std::size_t j = 0; j < average.size(); ++j)
+      for (int d = 0; d < D; ++d) average[j][d] = surface_force_sum_[j][d] / surface_force_time_;
+  } else {
+    surface_->node_forces(average);  // no step taken yet: the forces of the current state
+  }
+  return average;
+}
+
+template <int D>
+void FluidSolver<D>::save_checkpoint() {
+  if (!checkpoint_) checkpoint_ = std::make_shared<Checkpoint>();
+  auto& c = *checkpoint_;
+  c.particles = particles_;
+  c.plates = plates_;
+  c.body_forces = body_forces_;
+  c.body_acceleration = body_acceleration_;
+  c.time = time_;
+  c.dt = dt_;
+  c.steps = steps_;
+  c.lost = lost_;
+  c.lost_density = lost_density_;
+  c.max_speed = max_speed_;
+  c.max_acceleration = max_acceleration_;
+  if (surface_) surface_->save_checkpoint();
+}
+
+template <int D>
+void FluidSolver<D>::restore_checkpoint() {
+  if (!checkpoint_) throw std::logic_error("FluidSolver::restore_checkpoint: no checkpoint was saved");
+  const auto& c = *checkpoint_;
+  particles_ = c.particles;
+  plates_ = c.plates;
+  body_forces_ = c.body_forces;
+  body_acceleration_ = c.body_acceleration;
+  time_ = c.time;
+  dt_ = c.dt;
+  steps_ = c.steps;
+  lost_ = c.lost;
+  lost_density_ = c.lost_density;
+  max_speed_ = c.max_speed;
+  max_acceleration_ = c.max_acceleration;
+  // The saved particles are already in cell order; sorting again rebuilds the grid's cell
+  // ranges and the pair-loop scratch without changing the order.
+  grid_.sort(particles_);
+  if (surface_) {
+    surface_->restore_checkpoint();
+    classify_surface();
+  }
+  evaluate_rates();
+}
+
+template <int D>
 void FluidSolver<D>::evaluate_rates() {
+  const PairFilter<D> filter = pair_filter();
   update_fluid_pressure<D>(particles_, settings_);
+  if (surface_) surface_->update_surface_states(particles_, grid_);
   for (std::size_t k = 0; k < plates_.size(); ++k)
     for (int d = 0; d < D; ++d) body_acceleration_[k + 1][d] = plates_[k].acceleration * plates_[k].normal[d];
-  update_wall_state<D>(particles_, grid_, settings_, body_acceleration_);
-  compute_fluid_rates<D>(particles_, grid_, settings_);
+  update_wall_state<D>(particles_, grid_, settings_, body_acceleration_, filter);
+  compute_fluid_rates<D>(particles_, grid_, settings_, filter);
+  if (surface_) surface_->add_surface_rates(particles_);
   if (!plates_.empty() || body_forces_requested_ || body_forces_always_) {
     body_forces_ = compute_body_forces<D>(particles_, grid_, settings_, plates_.size() + 1,
-                                          body_forces_requested_ || body_forces_always_);
+                                          body_forces_requested_ || body_forces_always_, filter);
     body_forces_requested_ = false;
   }
 }
@@ -65,6 +172,7 @@ void FluidSolver<D>::step() {
   const float full = static_cast<float>(dt);
   auto& p = particles_;
   const auto n = static_cast<std::ptrdiff_t>(p.size());
+  if (surface_) surface_->begin_step(p);
 
   // First kick (velocity half step, density predicted to the full step) and drift (eq. 4).
 #pragma omp parallel for schedule(static)
@@ -94,10 +202,24 @@ void FluidSolver<D>::step() {
     }
   }
   time_ += dt;
+  if (surface_) {
+    surface_->move_to(time_);
+    surface_->correct_crossings(p);
+  }
 
   lost_ += grid_.wrap_and_mark_lost(p);
   grid_.sort(p);
+  if (surface_) classify_surface();
   evaluate_rates();
+  if (surface_) {
+    // Window average of the surface loads: each step's forces weighted by its length.
+    surface_force_scratch_.resize(surface_->node_count());
+    surface_->node_forces(surface_force_scratch_);
+    if (surface_force_sum_.size() != surface_force_scratch_.size()) reset_surface_force_average();
+    for (std::size_t j = 0; j < surface_force_scratch_.size(); ++j)
+      for (int d = 0; d < D; ++d) surface_force_sum_[j][d] += dt * surface_force_scratch_[j][d];
+    surface_force_time_ += dt;
+  }
 
   for (std::size_t k = 0; k < plates_.size(); ++k) {
     auto& plate = plates_[k];
@@ -146,16 +268,35 @@ void FluidSolver<D>::shift_particles(double dt) {
   const double scale = s.shifting * s.smoothing_length() * max_speed_ * dt;
   const double cap = s.max_shift_fraction * s.particle_spacing;
   const auto n = static_cast<std::ptrdiff_t>(p.size());
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    if (p.kind[i] != Kind::fluid || p.kernel_sum[i] < s.free_surface_kernel_sum) continue;
-    double shift[D], length2 = 0;
+  const bool with_surface = surface_ != nullptr && near_surface_.size() == p.size();
+  auto shift_of = [&](std::ptrdiff_t i) {
+    Vec<D> shift{};
+    double length2 = 0;
     for (int d = 0; d < D; ++d) {
       shift[d] = -scale * p.kernel_sum_gradient[d][i];
       length2 += shift[d] * shift[d];
     }
     const double factor = length2 > cap * cap ? cap / std::sqrt(length2) : 1.0;
-    for (int d = 0; d < D; ++d) p.position[d][i] += factor * shift[d];
+    for (int d = 0; d < D; ++d) shift[d] *= factor;
+    return shift;
+  };
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    if (p.kind[i] != Kind::fluid || p.kernel_sum[i] < s.free_surface_kernel_sum) continue;
+    if (with_surface && near_surface_[static_cast<std::size_t>(i)]) continue;  // asked below
+    const Vec<D> shift = shift_of(i);
+    for (int d = 0; d < D; ++d) p.position[d][i] += shift[d];
+  }
+  if (!with_surface) return;
+  // Near the surface the model decides (a shift must not carry a particle across it); the
+  // model keeps counters, so these calls stay on one thread.
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    if (!near_surface_[static_cast<std::size_t>(i)] || p.kind[i] != Kind::fluid ||
+        p.kernel_sum[i] < s.free_surface_kernel_sum)
+      continue;
+    const Vec<D> shift = shift_of(i);
+    if (!surface_->accept_shift(p, static_cast<std::size_t>(i), shift)) continue;
+    for (int d = 0; d < D; ++d) p.position[d][i] += shift[d];
   }
 }
 
@@ -177,7 +318,9 @@ void FluidSolver<D>::choose_time_step() {
     }
     max_acceleration_ = std::sqrt(a2);
   }
-  double dt = s.cfl * h / (s.sound_speed + max_speed_);                        // acoustic
+  // The surface's nodes count as fluid speed: a moving leaflet must not outrun the step.
+  const double speed = std::max<double>(max_speed_, surface_ ? surface_->max_node_speed() : 0.0);
+  double dt = s.cfl * h / (s.sound_speed + speed);                             // acoustic
   if (max_acceleration_ > 0) dt = std::min(dt, s.cfl * std::sqrt(h / max_acceleration_));  // force
   if (s.dynamic_viscosity > 0) dt = std::min(dt, 0.125 * h * h * s.rest_density / s.dynamic_viscosity);  // viscous (Morris et al. 1997)
   dt_ = std::min(dt, s.max_time_step);

@@ -71,9 +71,11 @@ struct Rates3 {
 // The artificial viscosity uses 1/rho_bar = (1/rho_a + 1/rho_b)/2 instead of
 // 2/(rho_a + rho_b): equal to second order in the (sub-percent) density variation, and it
 // keeps divisions out of the loop.
-template <int D, bool WithArtificialViscosity, bool OnlyFluidNeighbours, bool WithKernelSum, class Kernel>
+// Masked: pairs the filter blocks are left out (scalar calls; only near an immersed surface).
+template <int D, bool WithArtificialViscosity, bool OnlyFluidNeighbours, bool WithKernelSum, bool Masked, class Kernel>
 inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, const Kernel& W, std::uint32_t a,
-                        const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments, int segment_count) {
+                        const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments, int segment_count,
+                        const PairFilter<D>& filter) {
   const float excess_a = p.excess[a];
   const float inv_a = p.inverse_density[a];
   const float p_a = p.pressure[a];
@@ -107,7 +109,9 @@ inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, con
       const float dz = D == 3 ? xa[2] - x2[b] : 0.0f;
       const float r2 = dx * dx + dy * dy + dz * dz;
       const float r = std::sqrt(r2);
-      const float F = W.gradient_factor(r);  // zero beyond the support
+      float keep = 1.0f;
+      if constexpr (Masked) keep = filter.blocked(a, b) ? 0.0f : 1.0f;
+      const float F = W.gradient_factor(r) * keep;  // zero beyond the support
       const float is_fluid = fluid[b];
       const float weight = OnlyFluidNeighbours ? F * is_fluid : F;
       const float inv_b = inv[b];
@@ -130,7 +134,7 @@ inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, con
       if constexpr (D == 3) g_dot_rba -= k.gravity[D - 1] * dz;
       diff += is_fluid * (ex[b] - excess_a - k.hydrostatic * g_dot_rba) * (-F) * inv_b;
       if constexpr (WithKernelSum) {
-        csum += W.value(r) * inv_b;
+        csum += W.value(r) * keep * inv_b;
         cgx += F * dx * inv_b;
         cgy += F * dy * inv_b;
         if constexpr (D == 3) cgz += F * dz * inv_b;
@@ -157,15 +161,26 @@ inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, con
 constexpr int kLanes = 8;
 constexpr int kBlock = 64;  // lanes per pass; larger cells are processed in several passes
 
-template <int D, bool WithArtificialViscosity, bool WithKernelSum, class Kernel>
+// Masked (cells whose neighbourhood holds a near-surface particle): a per-lane weight of 0
+// leaves out the pairs the filter blocks; it is recomputed only for neighbours b where a
+// block or b is near the surface, so the SIMD sums themselves are unchanged.
+template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, class Kernel>
 [[gnu::noinline]] void cell_block_rates(Particles<D>& particles, const ParticleView<D>& p, const PairConstants<D>& k, const Kernel& W,
                       std::uint32_t first, std::uint32_t last,
-                      const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments, int segment_count) {
+                      const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments, int segment_count,
+                      const PairFilter<D>& filter) {
   alignas(64) float xa[3][kBlock], va[3][kBlock], wa[3][kBlock], pa[kBlock], inva[kBlock], exa[kBlock];
   alignas(64) float acc[3][kBlock], cont[kBlock], diff[kBlock], csum[kBlock], cg[3][kBlock];
+  alignas(64) float keep[kBlock];
   for (std::uint32_t block = first; block < last; block += kBlock) {
     const int n = static_cast<int>(std::min<std::uint32_t>(kBlock, last - block));
     const int padded = (n + kLanes - 1) / kLanes * kLanes;
+    bool block_near = false;
+    if constexpr (Masked) {
+      for (int i = 0; i < kBlock; ++i) keep[i] = 1.0f;
+      for (int i = 0; i < n; ++i) block_near = block_near || filter.is_near(block + static_cast<std::uint32_t>(i));
+    }
+    bool keep_dirty = false;
     for (int i = 0; i < padded; ++i) {
       const bool real = i < n;
       const std::uint32_t a = block + static_cast<std::uint32_t>(real ? i : 0);
@@ -191,12 +206,22 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, class Kernel>
         const float vxb = p.v[0][b], vyb = p.v[1][b], vzb = D == 3 ? p.v[D - 1][b] : 0.0f;
         const float wxb = p.vv[0][b], wyb = p.vv[1][b], wzb = D == 3 ? p.vv[D - 1][b] : 0.0f;
         const float p_b = p.pressure[b], inv_b = p.inverse_density[b], ex_b = p.excess[b], is_fluid = p.fluid[b];
-#pragma omp simd aligned(xa, va, wa, pa, inva, exa, acc, cont, diff, csum, cg : 64)
+        if constexpr (Masked) {
+          if (block_near || filter.is_near(b)) {
+            for (int i = 0; i < n; ++i) keep[i] = filter.blocked(block + static_cast<std::uint32_t>(i), b) ? 0.0f : 1.0f;
+            keep_dirty = true;
+          } else if (keep_dirty) {
+            for (int i = 0; i < n; ++i) keep[i] = 1.0f;
+            keep_dirty = false;
+          }
+        }
+#pragma omp simd aligned(xa, va, wa, pa, inva, exa, acc, cont, diff, csum, cg, keep : 64)
         for (int i = 0; i < padded; ++i) {
           const float dx = xa[0][i] - xb, dy = xa[1][i] - yb, dz = D == 3 ? xa[2][i] - zb : 0.0f;
           const float r2 = dx * dx + dy * dy + dz * dz;
           const float r = std::sqrt(r2);
-          const float F = W.gradient_factor(r);
+          float F = W.gradient_factor(r);
+          if constexpr (Masked) F *= keep[i];
           const float inv_rr = inva[i] * inv_b;
           const float vdx = (va[0][i] - vxb) * dx + (va[1][i] - vyb) * dy + (D == 3 ? (va[2][i] - vzb) * dz : 0.0f);
           cont[i] += vdx * F;
@@ -217,7 +242,7 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, class Kernel>
           if constexpr (D == 3) g_dot_rba -= k.gravity[D - 1] * dz;
           diff[i] += is_fluid * (ex_b - exa[i] - k.hydrostatic * g_dot_rba) * (-F) * inv_b;
           if constexpr (WithKernelSum) {
-            csum[i] += W.value(r) * inv_b;
+            csum[i] += W.value(r) * (Masked ? keep[i] : 1.0f) * inv_b;
             cg[0][i] += F * dx * inv_b;
             cg[1][i] += F * dy * inv_b;
             if constexpr (D == 3) cg[2][i] += F * dz * inv_b;
@@ -262,7 +287,7 @@ void update_fluid_pressure(Particles<D>& p, const FluidSettings<D>& s) {
 
 template <int D>
 void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s,
-                       const std::vector<Vec<D>>& body_acceleration) {
+                       const std::vector<Vec<D>>& body_acceleration, const PairFilter<D>& filter) {
   const LinearMieGruneisen eos{s.rest_density, s.sound_speed};
   const ParticleView<D> view(p);
   const float rho0 = static_cast<float>(s.rest_density);
@@ -277,6 +302,7 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
         for (int d = 0; d < D; ++d) xw[d] = view.x[d][w] - static_cast<float>(seg.shift[d]);
         for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
           if (view.kind[b] != Kind::fluid) continue;
+          if (filter.active() && filter.blocked(w, b)) continue;
           float dx[3] = {0, 0, 0};
           float r2 = 0;
           for (int d = 0; d < D; ++d) {
@@ -320,7 +346,7 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
 }
 
 template <int D>
-void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s) {
+void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s, const PairFilter<D>& filter) {
   const PairConstants<D> k(s);
   const ParticleView<D> view(p);
   const bool shifting = s.shifting > 0;
@@ -342,12 +368,17 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
         for (std::uint32_t a = first; a < last && !any_fluid; ++a) any_fluid = p.kind[a] == Kind::fluid;
         if (!any_fluid) continue;
         const int count = grid.neighbour_segments(static_cast<std::size_t>(c), segments);
+        const bool masked = filter.touches(segments, count);
+        auto run = [&]<bool AV, bool KS>() {
+          if (masked) cell_block_rates<D, AV, KS, true>(p, view, k, W, first, last, segments, count, filter);
+          else cell_block_rates<D, AV, KS, false>(p, view, k, W, first, last, segments, count, filter);
+        };
         if (k.alpha_c0 > 0) {
-          if (shifting) cell_block_rates<D, true, true>(p, view, k, W, first, last, segments, count);
-          else cell_block_rates<D, true, false>(p, view, k, W, first, last, segments, count);
+          if (shifting) run.template operator()<true, true>();
+          else run.template operator()<true, false>();
         } else {
-          if (shifting) cell_block_rates<D, false, true>(p, view, k, W, first, last, segments, count);
-          else cell_block_rates<D, false, false>(p, view, k, W, first, last, segments, count);
+          if (shifting) run.template operator()<false, true>();
+          else run.template operator()<false, false>();
         }
       }
     }
@@ -356,7 +387,7 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
 
 template <int D>
 std::vector<Vec<D>> compute_body_forces(const Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s,
-                                        std::size_t body_count, bool include_fixed_walls) {
+                                        std::size_t body_count, bool include_fixed_walls, const PairFilter<D>& filter) {
   const PairConstants<D> k(s);
   const ParticleView<D> view(p);
   const int threads = omp_get_max_threads();
@@ -365,8 +396,13 @@ std::vector<Vec<D>> compute_body_forces(const Particles<D>& p, const CellGrid<D>
     for_each_particle_with_neighbours<D>(grid, [&](std::uint32_t w, const auto& segments, int count) {
       if (p.kind[w] != Kind::wall || p.body[w] >= body_count || !p.near_fluid[w]) return;
       if (p.body[w] == 0 && !include_fixed_walls) return;
-      const Rates3 r = k.alpha_c0 > 0 ? pair_sums<D, true, true, false>(view, k, W, w, segments, count)
-                                      : pair_sums<D, false, true, false>(view, k, W, w, segments, count);
+      Rates3 r;
+      if (filter.touches(segments, count))
+        r = k.alpha_c0 > 0 ? pair_sums<D, true, true, false, true>(view, k, W, w, segments, count, filter)
+                           : pair_sums<D, false, true, false, true>(view, k, W, w, segments, count, filter);
+      else
+        r = k.alpha_c0 > 0 ? pair_sums<D, true, true, false, false>(view, k, W, w, segments, count, filter)
+                           : pair_sums<D, false, true, false, false>(view, k, W, w, segments, count, filter);
       double* f = per_thread.data() + (static_cast<std::size_t>(omp_get_thread_num()) * body_count + p.body[w]) * D;
       for (int d = 0; d < D; ++d) f[d] += static_cast<double>(k.mass) * k.mass * r.acc[d];
     });
@@ -380,11 +416,11 @@ std::vector<Vec<D>> compute_body_forces(const Particles<D>& p, const CellGrid<D>
 
 template void update_fluid_pressure<2>(Particles<2>&, const FluidSettings<2>&);
 template void update_fluid_pressure<3>(Particles<3>&, const FluidSettings<3>&);
-template void update_wall_state<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, const std::vector<Vec<2>>&);
-template void update_wall_state<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, const std::vector<Vec<3>>&);
-template void compute_fluid_rates<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&);
-template void compute_fluid_rates<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&);
-template std::vector<Vec<2>> compute_body_forces<2>(const Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, std::size_t, bool);
-template std::vector<Vec<3>> compute_body_forces<3>(const Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, std::size_t, bool);
+template void update_wall_state<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, const std::vector<Vec<2>>&, const PairFilter<2>&);
+template void update_wall_state<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, const std::vector<Vec<3>>&, const PairFilter<3>&);
+template void compute_fluid_rates<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, const PairFilter<2>&);
+template void compute_fluid_rates<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, const PairFilter<3>&);
+template std::vector<Vec<2>> compute_body_forces<2>(const Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, std::size_t, bool, const PairFilter<2>&);
+template std::vector<Vec<3>> compute_body_forces<3>(const Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, std::size_t, bool, const PairFilter<3>&);
 
 }  // namespace valvefsi::fluid

@@ -1,11 +1,16 @@
 #pragma once
 // The weakly compressible SPH solver: owns the particles, the cell grid and the moving
-// bodies, and advances them with a kick-drift-kick velocity-Verlet step.
+// bodies, and advances them with a kick-drift-kick velocity-Verlet step. An optional
+// immersed-surface model (the leaflets) joins the step in the order its header prescribes.
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "valvefsi/fluid/cell_grid.hpp"
 #include "valvefsi/fluid/fluid_settings.hpp"
+#include "valvefsi/fluid/immersed_surface.hpp"
+#include "valvefsi/fluid/pair_filter.hpp"
 #include "valvefsi/fluid/particles.hpp"
 #include "valvefsi/fluid/pressure_plate.hpp"
 
@@ -15,7 +20,24 @@ template <int D>
 class FluidSolver {
  public:
   // Wall particles with body k > 0 belong to plates[k - 1]; body 0 walls are fixed.
-  FluidSolver(const FluidSettings<D>& settings, Particles<D> particles, std::vector<PressurePlate<D>> plates = {});
+  FluidSolver(const FluidSettings<D>& settings, Particles<D> particles, std::vector<PressurePlate<D>> plates = {},
+              std::unique_ptr<ImmersedSurfaceModel<D>> surface = nullptr);
+
+  // Installs (or removes, with nullptr) the immersed-surface model and re-evaluates the rates
+  // of the current state with it.
+  void set_immersed_surface(std::unique_ptr<ImmersedSurfaceModel<D>> surface);
+  ImmersedSurfaceModel<D>* immersed_surface() { return surface_.get(); }
+  const ImmersedSurfaceModel<D>* immersed_surface() const { return surface_.get(); }
+  // The surface model's node forces averaged over the steps since the last reset, weighted by
+  // each step's length (what a coupling window sends); empty without a surface.
+  void reset_surface_force_average();
+  std::vector<Vec<D>> surface_force_average() const;
+
+  // Saves / restores the whole state (particles, plates, time, step, the surface model's own
+  // checkpoint), so an implicit coupling scheme can repeat a window.
+  void save_checkpoint();
+  void restore_checkpoint();
+  bool has_checkpoint() const { return checkpoint_ != nullptr; }
 
   // Advances by time_step() and then chooses the next time step.
   void step();
@@ -44,6 +66,10 @@ class FluidSolver {
   void evaluate_rates();
   void choose_time_step();
   void shift_particles(double dt);
+  void classify_surface();
+  PairFilter<D> pair_filter() const;
+
+  struct Checkpoint;
 
   FluidSettings<D> settings_;
   Particles<D> particles_;
@@ -60,6 +86,12 @@ class FluidSolver {
   std::size_t lost_density_ = 0;
   float max_speed_ = 0.0f;
   float max_acceleration_ = 0.0f;
+  std::unique_ptr<ImmersedSurfaceModel<D>> surface_;
+  std::vector<std::uint8_t> near_surface_;  // per sorted particle, after classify
+  std::vector<Vec<D>> surface_force_sum_;   // sum of node force x dt since the reset
+  double surface_force_time_ = 0.0;
+  std::vector<Vec<D>> surface_force_scratch_;
+  std::shared_ptr<Checkpoint> checkpoint_;
 };
 
 }  // namespace valvefsi::fluid

@@ -7,11 +7,13 @@
 //                            pressure, laminar viscosity (eq. 3) and artificial viscosity
 //   compute_body_forces    - the force the fluid exerts on each wall body (action = reaction
 //                            of the pair forces of compute_fluid_rates)
+// Each pair pass leaves out the pairs an immersed surface blocks (`filter`, inactive by default).
 #include <cstddef>
 #include <vector>
 
 #include "valvefsi/fluid/cell_grid.hpp"
 #include "valvefsi/fluid/fluid_settings.hpp"
+#include "valvefsi/fluid/pair_filter.hpp"
 #include "valvefsi/fluid/particles.hpp"
 
 namespace valvefsi::fluid {
@@ -22,10 +24,11 @@ void update_fluid_pressure(Particles<D>& particles, const FluidSettings<D>& sett
 // body_acceleration[k]: acceleration of body k (0: fixed walls), enters the wall pressure.
 template <int D>
 void update_wall_state(Particles<D>& particles, const CellGrid<D>& grid, const FluidSettings<D>& settings,
-                       const std::vector<Vec<D>>& body_acceleration);
+                       const std::vector<Vec<D>>& body_acceleration, const PairFilter<D>& filter = {});
 
 template <int D>
-void compute_fluid_rates(Particles<D>& particles, const CellGrid<D>& grid, const FluidSettings<D>& settings);
+void compute_fluid_rates(Particles<D>& particles, const CellGrid<D>& grid, const FluidSettings<D>& settings,
+                         const PairFilter<D>& filter = {});
 
 // Force (N; per unit depth in 2D) of the fluid on each body 0..body_count-1; the fixed walls
 // (body 0) only if include_fixed_walls (they are usually most of the dummy particles).
@@ -33,6 +36,6 @@ void compute_fluid_rates(Particles<D>& particles, const CellGrid<D>& grid, const
 template <int D>
 std::vector<Vec<D>> compute_body_forces(const Particles<D>& particles, const CellGrid<D>& grid,
                                         const FluidSettings<D>& settings, std::size_t body_count,
-                                        bool include_fixed_walls);
+                                        bool include_fixed_walls, const PairFilter<D>& filter = {});
 
 }  // namespace valvefsi::fluid

@@ -17,6 +17,7 @@ from pathlib import Path
 from . import waveform
 from .mesh_io import write_mesh
 from .tube_case import fluid_block
+from .valve_geometry import ValveParameters
 from .valve_mesh import RESOLUTIONS, build_valve_mesh
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
@@ -125,7 +126,21 @@ def solid_block(spec: CaseSpec) -> str:
             f"  density: {LEAFLET_DENSITY:g}\n"
             "  fixed_node_sets: \"attachment\"\n"
             "  monitor_node_sets: \"free_edge_midpoints\"\n"
+            + stent_cylinder_lines() +
             "}\n")
+
+
+def stent_radius() -> float:
+    """The stent's inner face: the generator puts the leaflet mid-surface on r = R at the
+    attachment, so the face is half a leaflet thickness farther out (with R itself, free
+    nodes beside the commissure tabs would start up to 0.11 mm inside the penalty zone)."""
+    p = ValveParameters()
+    return p.annulus_radius + 0.5 * p.thickness
+
+
+def stent_cylinder_lines() -> str:
+    return ("  # rigid stent: the leaflets' mid-surface stays within R + t/2 - t/2 = R of the axis\n"
+            f"  contact_cylinders {{ origin: [0, 0, 0] axis: [0, 0, 1] radius: {stent_radius():.6g} }}\n")
 
 
 def coupling_block() -> str:

@@ -48,6 +48,10 @@ TEST(SceneCaseFiles, LoadAndMatchTheirNames) {
     EXPECT_EQ(valvefsi::resolve_case_path(file, c.solid().mesh_file()),
               fs::path(VALVEFSI_CASES_DIR) / "meshes" / ("valve-" + m[3].str() + "-" + m[4].str() + ".mesh.h5"));
     EXPECT_DOUBLE_EQ(c.solid().density(), 1100.0);
+    // the rigid stent: its inner face half a leaflet thickness outside the attachment line
+    ASSERT_EQ(c.solid().contact_cylinders_size(), 1);
+    EXPECT_DOUBLE_EQ(c.solid().contact_cylinders(0).radius(), 11.5e-3 + 0.125e-3);
+    EXPECT_EQ(c.solid().contact_cylinders(0).axis(2), 1.0);
     if (m[1] == "fsi") {
       EXPECT_DOUBLE_EQ(c.fluid().density(), 1056.0);
       EXPECT_DOUBLE_EQ(c.fluid().sound_speed(), 145.0);

@@ -3,7 +3,11 @@ models, what it should show and the command that runs it (issue 4, item 4)."""
 import unittest
 from pathlib import Path
 
-from valve_scene.write_cases import all_specs, case_text
+import numpy as np
+
+from valve_scene.valve_geometry import ValveParameters
+from valve_scene.valve_mesh import RESOLUTIONS, build_valve_mesh
+from valve_scene.write_cases import all_specs, case_text, stent_radius
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
@@ -27,6 +31,23 @@ class CaseFiles(unittest.TestCase):
     def test_sector_cases_use_sector_meshes(self):
         for spec in all_specs():
             self.assertIn(f'mesh_file: "meshes/valve-{spec.variant}-{spec.resolution}.mesh.h5"', case_text(spec))
+
+    def test_every_3d_case_has_the_stent_cylinder(self):
+        for spec in all_specs():
+            self.assertIn(f"contact_cylinders {{ origin: [0, 0, 0] axis: [0, 0, 1] radius: {stent_radius():.6g} }}", case_text(spec))
+
+    def test_no_free_node_starts_inside_the_stent_penalty_zone(self):
+        # mid-surface + t/2 within the cylinder for every node the solid moves
+        t = ValveParameters().thickness
+        worst = []
+        for resolution in RESOLUTIONS:
+            mesh = build_valve_mesh("full", resolution, "triangles")
+            free = np.setdiff1d(np.arange(len(mesh.nodes)), mesh.node_sets["attachment"])
+            r = np.hypot(mesh.nodes[free, 0], mesh.nodes[free, 1])
+            worst.append(r.max() + 0.5 * t - stent_radius())
+        self.assertTrue(all(w <= 0 for w in worst), worst)
+        # with the annulus radius itself as the face, the fine mesh would start in contact
+        self.assertGreater(worst[-1] + 0.5 * t, 0)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
 // solid_fe: the leaflet finite-element solver. FE-only mode applies the case's uniform
-// transvalvular pressure to the leaflets and runs to run.end_time (docs/solid_fe.md).
+// transvalvular pressure to the leaflets and runs to run.end_time; otherwise it is the
+// coupler's structure participant (participant_mode.cpp, docs/solid_fe.md).
 //   solid_fe --case cases/<name>.textproto [--fe-only] [--output DIR]
 #include <algorithm>
 #include <chrono>
@@ -19,6 +20,7 @@
 #include "valvefsi/solid/case_setup.hpp"
 #include "valvefsi/solid/material_error.hpp"
 #include "valvefsi/solid/solid_output.hpp"
+#include "participant_mode.hpp"
 
 namespace {
 
@@ -105,22 +107,18 @@ int run_fe_only(const valvefsi::cases::Case& c, const std::filesystem::path& cas
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"solid_fe: leaflet finite-element solver (FE-only, or a coupled participant later)"};
+  CLI::App app{"solid_fe: leaflet finite-element solver (FE-only, or the coupler's structure participant)"};
   std::string case_path, output;
   bool fe_only = false;
   app.add_option("--case", case_path, "case file (protobuf text format, message valvefsi.cases.Case)")->required();
-  app.add_flag("--fe-only", fe_only, "run alone under the case's uniform transvalvular pressure");
+  app.add_flag("--fe-only", fe_only, "run alone under the case's uniform transvalvular pressure (default: coupled participant)");
   app.add_option("--output", output, "output folder (default: the case's run.output_dir)");
   CLI11_PARSE(app, argc, argv);
   spdlog::set_pattern("[solid] %v");
   try {
     const valvefsi::cases::Case c = valvefsi::load_case(case_path);
-    if (!fe_only && !c.run().fe_only()) {
-      spdlog::error("{}: the coupled (participant) mode is not implemented yet; run with --fe-only "
-                    "or set run.fe_only: true", case_path);
-      return 2;
-    }
     const std::filesystem::path output_dir = std::filesystem::path(output.empty() ? c.run().output_dir() : output);
+    if (!fe_only && !c.run().fe_only()) return valvefsi::solid::run_participant(c, case_path, output_dir);
     return run_fe_only(c, case_path, output_dir);
   } catch (const valvefsi::CaseError& e) {
     spdlog::error("{}", e.what());

@@ -155,6 +155,50 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
                                       "(leaflet-leaflet contact is NOT implemented yet)", name));
     setup.solver->add_contact_plane(plane);
   }
+  for (int k = 0; k < solid.contact_cylinders_size(); ++k) {
+    const auto& cyl = solid.contact_cylinders(k);
+    const std::string field = fmt::format("solid.contact_cylinders[{}]", k);
+    if (cyl.origin_size() != 3 || cyl.axis_size() != 3) {
+      throw CaseError(fmt::format("{}: field '{}': origin has {} and axis {} values; allowed 3 each", source, field,
+                                  cyl.origin_size(), cyl.axis_size()));
+    }
+    ContactCylinder cylinder;
+    cylinder.origin = Eigen::Vector3d(cyl.origin(0), cyl.origin(1), cyl.origin(2));
+    cylinder.axis = Eigen::Vector3d(cyl.axis(0), cyl.axis(1), cyl.axis(2));
+    cylinder.radius = cyl.radius();
+    if (!(cylinder.axis.norm() > 0.0)) {
+      throw CaseError(fmt::format("{}: field '{}.axis' = [0, 0, 0]: allowed a non-zero direction", source, field));
+    }
+    setup.notes.push_back(fmt::format("contact cylinder {}: radius {} m, axis [{}]: leaflets stay inside by t/2",
+                                      k, cylinder.radius, fmt::join(cyl.axis(), ", ")));
+    setup.solver->add_contact_cylinder(cylinder);
+  }
+  setup.dimension = c.run().has_dimension() ? c.run().dimension() : 3;
+  setup.strip_depth = solid.strip_depth();
+  if (setup.dimension == 2) {
+    const auto& front = node_set(mesh, "strip_front", "run.dimension = 2 needs node set", source, mesh_name);
+    const auto& back = node_set(mesh, "strip_back", "run.dimension = 2 needs node set", source, mesh_name);
+    if (front.size() != back.size() || front.empty()) {
+      throw CaseError(fmt::format("{}: run.dimension = 2: {} has {} strip_front and {} strip_back nodes; allowed the "
+                                  "same non-zero number (pairs in the same order)", source, mesh_name, front.size(),
+                                  back.size()));
+    }
+    const double tolerance = 1e-6 * std::max(size, setup.strip_depth);
+    for (std::size_t k = 0; k < front.size(); ++k) {
+      const Eigen::Vector3d f = mesh.nodes.col(front[k]), b = mesh.nodes.col(back[k]);
+      if (std::abs(f.z()) > tolerance || std::abs(b.z() - setup.strip_depth) > tolerance ||
+          (f - b).head<2>().norm() > tolerance) {
+        throw CaseError(fmt::format(
+            "{}: run.dimension = 2: strip pair {} (nodes {}, {}) of {} is at [{}, {}, {}] and [{}, {}, {}]; allowed: "
+            "front at z = 0, back at z = solid.strip_depth = {} m, same x and y", source, k, front[k], back[k],
+            mesh_name, f.x(), f.y(), f.z(), b.x(), b.y(), b.z(), setup.strip_depth));
+      }
+      setup.strip_ties.push_back({front[k], back[k]});
+    }
+    setup.notes.push_back(fmt::format("2D plane-strain strip: {} front/back pairs tied, u_z = 0, depth {} m",
+                                      front.size(), setup.strip_depth));
+    setup.solver->set_strip_ties(setup.strip_ties);
+  }
   // Leaflet-leaflet contact between the surfaces named leaflet_0, leaflet_1, ...
   std::vector<int> surface_of_node(static_cast<std::size_t>(mesh.num_nodes()), -1);
   int leaflets = 0;

@@ -82,11 +82,35 @@ void ShellSolver::enable_leaflet_contact(std::vector<int> surface_of_node) {
   internal_force_current_ = false;
 }
 
+void ShellSolver::add_contact_cylinder(const ContactCylinder& cylinder) {
+  if (!(cylinder.radius > 0.0) || !(cylinder.axis.norm() > 0.0)) {
+    throw std::invalid_argument(fmt::format("solid: contact cylinder radius {} m, axis norm {}: allowed > 0",
+                                            cylinder.radius, cylinder.axis.norm()));
+  }
+  contact_cylinders_.push_back({cylinder.origin, cylinder.axis.normalized(), cylinder.radius});
+  internal_force_current_ = false;
+}
+
+void ShellSolver::set_strip_ties(std::vector<StripTie> ties) {
+  const Eigen::Index n = model_.reference_positions.cols();
+  for (const auto& t : ties) {
+    if (t.front < 0 || t.front >= n || t.back < 0 || t.back >= n || t.front == t.back) {
+      throw std::invalid_argument(fmt::format("solid: strip tie ({}, {}): nodes must differ and exist (mesh has {})",
+                                              t.front, t.back, n));
+    }
+  }
+  ties_ = std::move(ties);
+  planar_ = true;
+  apply_constraints(state_.velocity);
+  apply_constraints(state_.half_step_velocity);
+  internal_force_current_ = false;
+}
+
 void ShellSolver::compute_contact_force() {
   Eigen::Matrix3Xd& f = state_.contact_force;
   f.setZero();
   state_.nodes_in_contact = 0;
-  if (contact_planes_.empty() && !leaflet_contact_) return;
+  if (!has_contact()) return;
   // Penalty stiffness from the highest frequency the first step resolves, k = factor m (2/dt)^2,
   // then kept: a constant spring is conservative, and the step only shrinks as tissue stiffens.
   if (contact_omega2_ == 0.0) {
@@ -100,6 +124,19 @@ void ShellSolver::compute_contact_force() {
       const double gap = (x.col(i) - plane.point).dot(plane.normal) - half_thickness_(i);
       if (gap < 0.0 && !model_.fixed[static_cast<std::size_t>(i)]) {
         f.col(i) -= options_.contact_stiffness_factor * model_.nodal_mass(i) * omega2 * gap * plane.normal;
+        ++state_.nodes_in_contact;
+      }
+    }
+  }
+  for (const ContactCylinder& cylinder : contact_cylinders_) {
+    for (Eigen::Index i = 0; i < x.cols(); ++i) {
+      if (model_.fixed[static_cast<std::size_t>(i)]) continue;
+      const Eigen::Vector3d d = x.col(i) - cylinder.origin;
+      const Eigen::Vector3d radial = d - d.dot(cylinder.axis) * cylinder.axis;
+      const double r = radial.norm();
+      const double penetration = r + half_thickness_(i) - cylinder.radius;
+      if (penetration > 0.0 && r > 0.0) {
+        f.col(i) -= options_.contact_stiffness_factor * model_.nodal_mass(i) * omega2 * penetration * (radial / r);
         ++state_.nodes_in_contact;
       }
     }
@@ -119,6 +156,15 @@ void ShellSolver::set_velocity(const Eigen::Matrix3Xd& velocity) {
 }
 
 void ShellSolver::apply_constraints(Eigen::Matrix3Xd& field) const {
+  if (planar_) {
+    field.row(2).setZero();
+    for (const auto& t : ties_) {
+      const double ma = model_.nodal_mass(t.front), mb = model_.nodal_mass(t.back);
+      const Eigen::Vector3d mean = (ma * field.col(t.front) + mb * field.col(t.back)) / (ma + mb);
+      field.col(t.front) = mean;
+      field.col(t.back) = mean;
+    }
+  }
   for (const auto& c : symmetry_) {
     auto col = field.col(c.node);
     col -= col.dot(c.normal) * c.normal;
@@ -248,7 +294,7 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
     apply_constraints(a);
 
     // A penalty spring of k = factor m omega^2 raises the node's frequency by sqrt(1 + factor).
-    double dt = contact_planes_.empty() && !leaflet_contact_ ? state_.stable_step
+    double dt = !has_contact() ? state_.stable_step
                                         : state_.stable_step / std::sqrt(1.0 + options_.contact_stiffness_factor);
     // Land exactly on t_end; avoid a sliver step by splitting the last two evenly.
     const double remaining = t_end - state_.time;

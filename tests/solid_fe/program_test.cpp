@@ -1,6 +1,6 @@
 // solid_fe as users run it: an FE-only run of a small plate ends with code 0 and writes its
-// output; a case asking for the coupled mode (not implemented) or naming a missing mesh set
-// ends with code 2 and a message.
+// output; a case with a bad 2D strip, contact cylinder or missing mesh set ends with code 2 and
+// a message naming the field.
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -50,10 +50,16 @@ TEST(SolidProgram, FeOnlyRunWritesOutput) {
   EXPECT_NE(log_of(dir).find("done: t = 0.002"), std::string::npos) << log_of(dir);
 }
 
-TEST(SolidProgram, CoupledModeIsRefusedClearly) {
-  const auto dir = prepare("coupled", "", "");
-  EXPECT_EQ(run(dir, ""), 2);
-  EXPECT_NE(log_of(dir).find("--fe-only"), std::string::npos) << log_of(dir);
+TEST(SolidProgram, TwoDimensionalRunWithoutAStripIsRefusedClearly) {
+  const auto dir = prepare("nostrip", "dimension: 2", "");
+  EXPECT_EQ(run(dir, "--fe-only"), 2);
+  EXPECT_NE(log_of(dir).find("strip_front"), std::string::npos) << log_of(dir);
+}
+
+TEST(SolidProgram, BadContactCylinderIsReported) {
+  const auto dir = prepare("badcylinder", "", "contact_cylinders { origin: [0, 0] axis: [0, 0, 1] radius: 0.01 }");
+  EXPECT_EQ(run(dir, "--fe-only"), 2);
+  EXPECT_NE(log_of(dir).find("solid.contact_cylinders[0]"), std::string::npos) << log_of(dir);
 }
 
 TEST(SolidProgram, MissingNodeSetIsReported) {

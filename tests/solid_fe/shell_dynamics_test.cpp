@@ -199,6 +199,40 @@ TEST(ShellDynamics, ContactPlaneStopsTheMidSurfaceHalfAThicknessAway) {
   EXPECT_LT(solver.state().energy.relative_balance_error(), 1e-2);
 }
 
+TEST(ShellDynamics, StentCylinderStopsTheLeafletHalfAThicknessInside) {
+  // The same membrane pushed outward (+z) against the inside of a cylinder (axis along x, radius
+  // R, its wall 0.5 mm above the plate's centre line): the mid-surface's largest distance from
+  // the axis stops at R - t/2 within the penalty tolerance, and the contact work is recorded.
+  const double a = 0.01, t = 0.25e-3, R = 0.05, wall_z = 0.5e-3;
+  const Mesh mesh = rectangular_plate(a, a, 12, 12, t);
+  ShellModelOptions options;
+  options.fixed_nodes = join(join(mesh.node_sets.at("left"), mesh.node_sets.at("right")),
+                             join(mesh.node_sets.at("top"), mesh.node_sets.at("bottom")));
+  options.clamp_fixed_edges = false;
+  SolverOptions solver_options;
+  solver_options.mass_damping_per_s = 2000.0;
+  ShellSolver solver(build_shell_model(mesh, options), Material{NeoHookean{100e3}}, solver_options);
+  solver.set_pressure([](double) { return 2000.0; });
+  const Eigen::Vector3d origin(0, 0.5 * a, wall_z - R);
+  solver.add_contact_cylinder({origin, Eigen::Vector3d::UnitX(), R});
+  for (int k = 1; k <= 40; ++k) solver.advance_window(k * 1e-3);
+  double farthest = 0;
+  const Eigen::Matrix3Xd& x = solver.state().position;
+  for (Eigen::Index n = 0; n < x.cols(); ++n) {
+    farthest = std::max(farthest, std::hypot(x(1, n) - origin.y(), x(2, n) - origin.z()));
+  }
+  const double limit = R - 0.5 * t;
+  std::printf("stent contact: farthest mid-surface node %.4g t beyond R - t/2, %lld nodes in contact, "
+              "contact work %.3g J, balance error %.2e\n", (farthest - limit) / t,
+              static_cast<long long>(solver.state().nodes_in_contact), solver.state().energy.contact_work,
+              solver.state().energy.relative_balance_error());
+  EXPECT_GT(solver.state().nodes_in_contact, 10);
+  EXPECT_LT(farthest, limit + 0.1 * t) << "penetration beyond 10 % of the thickness";
+  EXPECT_GT(farthest, limit - 0.02 * t) << "the leaflet reaches the stent";
+  EXPECT_GT(solver.state().energy.contact_work, 0.0);
+  EXPECT_LT(solver.state().energy.relative_balance_error(), 1e-2);
+}
+
 
 TEST(ShellDynamics, TwoLeafletsPressedTogetherStopAThicknessApart) {
   // Two membranes 1 mm apart with normals facing each other; the pressure pushes both toward

@@ -3,6 +3,8 @@
 // circumferential axis along x, normal +z.
 #include <cmath>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "valvefsi/solid/mesh.hpp"
 
@@ -54,6 +56,62 @@ inline Mesh rectangular_plate(double lx, double ly, int nx, int ny, double thick
     m.node_sets["top"].push_back(grid_node(i, ny, nx));
   }
   return m;
+}
+
+// 2D strip leaflets (docs/mesh-format.md, "2D strips"): each polyline (x-y, attached end first)
+// extruded along +z by `depth`; front nodes (z = 0) leaflet after leaflet, then the back nodes in
+// the same order; two triangles per segment with normal z x (along the polyline).
+inline Mesh strip_mesh(const std::vector<std::vector<Eigen::Vector2d>>& leaflets, double depth, double thickness) {
+  Mesh m;
+  std::int64_t n = 0;
+  for (const auto& l : leaflets) n += static_cast<std::int64_t>(l.size());
+  m.nodes.resize(3, 2 * n);
+  std::int64_t first = 0;
+  std::vector<Eigen::Vector3d> circumferential, radial;
+  for (std::size_t k = 0; k < leaflets.size(); ++k) {
+    const auto& l = leaflets[k];
+    const auto count = static_cast<std::int64_t>(l.size());
+    for (std::int64_t i = 0; i < count; ++i) {
+      m.nodes.col(first + i) = Eigen::Vector3d(l[static_cast<std::size_t>(i)].x(), l[static_cast<std::size_t>(i)].y(), 0.0);
+      m.nodes.col(n + first + i) = Eigen::Vector3d(l[static_cast<std::size_t>(i)].x(), l[static_cast<std::size_t>(i)].y(), depth);
+      m.node_sets["strip_front"].push_back(first + i);
+      m.node_sets["strip_back"].push_back(n + first + i);
+      m.node_sets["leaflet_" + std::to_string(k)].push_back(first + i);
+      m.node_sets["leaflet_" + std::to_string(k)].push_back(n + first + i);
+    }
+    for (std::int64_t i = 0; i + 1 < count; ++i) {
+      const std::int64_t f0 = first + i, f1 = f0 + 1, b0 = n + f0, b1 = n + f1;
+      m.triangles.push_back({f0, b0, b1});
+      m.triangles.push_back({f0, b1, f1});
+      const Eigen::Vector2d s = (l[static_cast<std::size_t>(i + 1)] - l[static_cast<std::size_t>(i)]).normalized();
+      for (int t = 0; t < 2; ++t) {
+        circumferential.push_back(Eigen::Vector3d::UnitZ());
+        radial.push_back(Eigen::Vector3d(s.x(), s.y(), 0.0));
+      }
+    }
+    m.node_sets["attachment"].push_back(first);
+    m.node_sets["attachment"].push_back(n + first);
+    m.node_sets["free_edge"].push_back(first + count - 1);
+    m.node_sets["free_edge"].push_back(n + first + count - 1);
+    m.node_sets["free_edge_midpoints"].push_back(first + count - 1);
+    first += count;
+  }
+  m.triangle_thickness.assign(m.triangles.size(), thickness);
+  m.triangle_circumferential.resize(3, static_cast<Eigen::Index>(circumferential.size()));
+  m.triangle_radial.resize(3, static_cast<Eigen::Index>(radial.size()));
+  for (std::size_t t = 0; t < circumferential.size(); ++t) {
+    m.triangle_circumferential.col(static_cast<Eigen::Index>(t)) = circumferential[t];
+    m.triangle_radial.col(static_cast<Eigen::Index>(t)) = radial[t];
+  }
+  return m;
+}
+
+// A straight polyline of `segments` segments from `start` along `direction` (unit) over `length`.
+inline std::vector<Eigen::Vector2d> straight_polyline(Eigen::Vector2d start, Eigen::Vector2d direction, double length,
+                                                      int segments) {
+  std::vector<Eigen::Vector2d> p;
+  for (int i = 0; i <= segments; ++i) p.push_back(start + direction * (length * i / segments));
+  return p;
 }
 
 }  // namespace valvefsi::solid::testing

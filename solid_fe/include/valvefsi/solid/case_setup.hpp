@@ -23,6 +23,9 @@ struct SolidSetup {
   std::vector<std::int64_t> pressure_elements;  // empty: all triangles
   std::vector<MonitorSet> monitors;
   std::vector<std::string> notes;                // what was chosen, for the log
+  int dimension = 3;                             // run.dimension
+  double strip_depth = 0;                        // 2D: solid.strip_depth (m)
+  std::vector<StripTie> strip_ties;              // 2D: strip_front[k] with strip_back[k]
 };
 
 // Material from the case (parameters converted to SI). Throws CaseError naming the field.

@@ -54,6 +54,19 @@ struct SymmetryConstraint {
   Eigen::Vector3d normal;  // the node keeps zero displacement along this unit normal
 };
 
+// Rigid cylinder (stent): nodes keep their distance from the axis at most radius - t/2.
+struct ContactCylinder {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // a point on the axis
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   // unit direction
+  double radius = 0;
+};
+
+// A front/back node pair of a plane-strain strip (2D runs): both move alike in x-y.
+struct StripTie {
+  std::int64_t front;
+  std::int64_t back;
+};
+
 struct SolverOptions {
   double contact_stiffness_factor = 0.1;  // penalty k = factor * m * omega_max^2 per node
   double time_step_safety = 0.8;        // fraction of the estimated critical step
@@ -76,6 +89,12 @@ class ShellSolver {
   // Leaflet-leaflet contact between nodes and triangles of different surfaces (ids per node;
   // empty: any non-incident triangle).
   void enable_leaflet_contact(std::vector<int> surface_of_node);
+  // Stent: penalty contact keeping every free node inside the cylinder by half its thickness.
+  void add_contact_cylinder(const ContactCylinder& cylinder);
+  // Plane-strain strip (2D runs): u_z = 0 on every node and each pair moves alike in x-y
+  // (mass-weighted, so momentum and the energy balance hold).
+  void set_strip_ties(std::vector<StripTie> ties);
+  const std::vector<StripTie>& strip_ties() const { return ties_; }
   const LeafletContact* leaflet_contact() const { return leaflet_contact_ ? &*leaflet_contact_ : nullptr; }
   void set_velocity(const Eigen::Matrix3Xd& velocity);  // initial condition (before the first step)
 
@@ -99,6 +118,7 @@ class ShellSolver {
   void compute_contact_force();
   void apply_constraints(Eigen::Matrix3Xd& field) const;
   void update_kinetic_energy();
+  bool has_contact() const { return !contact_planes_.empty() || !contact_cylinders_.empty() || leaflet_contact_; }
 
   ShellModel model_;
   Material material_;
@@ -107,6 +127,9 @@ class ShellSolver {
   std::vector<std::int64_t> pressure_elements_;
   std::vector<SymmetryConstraint> symmetry_;
   std::vector<Plane> contact_planes_;
+  std::vector<ContactCylinder> contact_cylinders_;
+  std::vector<StripTie> ties_;
+  bool planar_ = false;  // u_z = 0 everywhere (strip mode)
   std::optional<LeafletContact> leaflet_contact_;
   double contact_omega2_ = 0.0;  // frequency^2 fixing the penalty stiffness, set at the first step
   Eigen::VectorXd half_thickness_;  // per node: half the largest adjacent element thickness

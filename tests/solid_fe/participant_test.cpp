@@ -1,0 +1,129 @@
+// solid_fe as the coupler's structure participant, as real processes: under the stand-in fluid's
+// uniform pressure its cantilever plate moves as in an FE-only run of the same pressure; the
+// implicit scheme (checkpoints) gives the explicit result; a killed fluid stops it with a message.
+#include <csignal>
+#include <cstdio>
+#include <regex>
+#include <thread>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "coupled_run.hpp"
+#include "solid_coupled_run.hpp"
+#include "test_meshes.hpp"
+#include "valvefsi/case/pressure_waveform.hpp"
+
+namespace valvefsi::solid::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr double kPressure_mmHg = 0.001;  // 0.133 Pa: static tip deflection ~0.13 mm on 10 mm
+
+SolidRunSpec cantilever(const std::string& name) {
+  SolidRunSpec spec;
+  spec.name = name;
+  spec.mesh = rectangular_plate(0.01, 0.005, 6, 4, 0.25e-3);
+  spec.mesh.node_sets["attachment"] = spec.mesh.node_sets.at("left");
+  spec.mesh.node_sets["free_edge_midpoints"] = {grid_node(6, 2, 6)};
+  spec.solid_extra = "material: SAINT_VENANT_KIRCHHOFF";
+  spec.end_time = 0.01;
+  spec.fluid_exe = valvefsi::testing::standin_exe("standin_fluid_pressure");
+  spec.fluid_args = {"--pressure", fmt::format("{:.15g}", kPressure_mmHg * kPascalPerMmHg)};
+  return spec;
+}
+
+double fe_only_tip_deflection() {
+  SolidRunSpec spec = cantilever("solid-fe-only-twin");
+  spec.waveform = fmt::format("waveform {{ period_s: 0.8 time_s: [0, 0.4] ventricular_pressure_mmHg: [{0}, {0}] "
+                              "aortic_pressure_mmHg: [0, 0] }}", kPressure_mmHg);
+  SolidCoupledRun run(spec, true);
+  EXPECT_EQ(run.wait(60), 0) << run.logs();
+  return run.final_monitor("free_edge_midpoints")(2, 0);
+}
+
+int repeated_windows(const std::string& log) {
+  static const std::regex pattern(R"((\d+) repeated windows)");
+  std::smatch m;
+  return std::regex_search(log, m, pattern) ? std::stoi(m[1].str()) : -1;
+}
+
+TEST(SolidParticipant, ExplicitCouplingMatchesFeOnlyUnderTheSamePressure) {
+  const double fe_only = fe_only_tip_deflection();
+  SolidCoupledRun run(cantilever("solid-explicit"));
+  ASSERT_EQ(run.wait(60), 0) << run.logs();
+  const double coupled = run.final_monitor("free_edge_midpoints")(2, 0);
+  // The stand-in pushes along +z at triangle centroids (mapped 1/3 to each node, as the FE-only
+  // load); FE-only pressure follows the normal, a difference of order slope^2 here (~1e-5).
+  EXPECT_GT(fe_only, 1e-5);
+  EXPECT_NEAR(coupled, fe_only, 5e-3 * fe_only) << "coupled " << coupled << " m, FE-only " << fe_only << " m";
+  std::printf("cantilever tip at 10 ms: FE-only %.6g m, coupled %.6g m (%+.3f %%)\n", fe_only, coupled,
+              100 * (coupled / fe_only - 1));
+}
+
+TEST(SolidParticipant, ImplicitCouplingRestoresCheckpointsAndGivesTheSameMotion) {
+  SolidCoupledRun explicit_run(cantilever("solid-explicit-2"));
+  ASSERT_EQ(explicit_run.wait(60), 0) << explicit_run.logs();
+  auto spec = cantilever("solid-implicit");
+  spec.coupling_extra = "scheme: SERIAL_IMPLICIT acceleration: AITKEN";
+  SolidCoupledRun implicit_run(spec);
+  ASSERT_EQ(implicit_run.wait(60), 0) << implicit_run.logs();
+  EXPECT_GT(repeated_windows(implicit_run.solid->log_text()), 0) << implicit_run.solid->log_text();
+  const double a = explicit_run.final_monitor("free_edge_midpoints")(2, 0);
+  const double b = implicit_run.final_monitor("free_edge_midpoints")(2, 0);
+  EXPECT_NEAR(b, a, 1e-9 * std::abs(a) + 1e-15) << "explicit " << a << ", implicit " << b;
+}
+
+TEST(SolidParticipant, KilledFluidStopsTheSolidWithAMessage) {
+  auto spec = cantilever("solid-kill-fluid");
+  spec.end_time = 100.0;  // never reached
+  spec.fluid_args.insert(spec.fluid_args.end(), {"--step-seconds", "0.02"});
+  SolidCoupledRun run(spec);
+  const auto deadline = std::chrono::steady_clock::now() + 30s;
+  while (std::chrono::steady_clock::now() < deadline && run.solid->log_text().find("coupled (") == std::string::npos) {
+    std::this_thread::sleep_for(20ms);
+  }
+  std::this_thread::sleep_for(300ms);
+  ASSERT_TRUE(run.solid->running()) << run.logs();
+  run.fluid->send_signal(SIGKILL);
+  const auto code = run.solid->wait_for_exit(10s);
+  ASSERT_TRUE(code.has_value()) << "solid still running:\n" << run.logs();
+  EXPECT_NE(*code, 0);
+  EXPECT_NE(run.solid->log_text().find("participant 'fluid'"), std::string::npos) << run.logs();
+}
+
+// 2D: a plane-strain strip cantilever (20 segments) under the strip fluid's pressure (forces per
+// unit depth on the front line) moves as the FE-only strip under the same pressure.
+SolidRunSpec strip_cantilever(const std::string& name) {
+  SolidRunSpec spec;
+  spec.name = name;
+  spec.mesh = strip_mesh({straight_polyline({0, 0}, {1, 0}, 0.01, 20)}, 1e-3, 0.5e-3);
+  spec.run_extra = "dimension: 2";
+  spec.solid_extra = "material: SAINT_VENANT_KIRCHHOFF strip_depth: 1e-3";
+  spec.end_time = 0.01;
+  spec.fluid_exe = STRIP_PRESSURE_FLUID_EXECUTABLE;
+  spec.fluid_args = {"--pressure", fmt::format("{:.15g}", kPressure_mmHg * kPascalPerMmHg)};
+  return spec;
+}
+
+TEST(SolidParticipant, StripCoupledIn2DMatchesFeOnly) {
+  SolidRunSpec twin = strip_cantilever("solid-strip-fe-only");
+  twin.waveform = fmt::format("waveform {{ period_s: 0.8 time_s: [0, 0.4] ventricular_pressure_mmHg: [{0}, {0}] "
+                              "aortic_pressure_mmHg: [0, 0] }}", kPressure_mmHg);
+  SolidCoupledRun fe_only(twin, true);
+  ASSERT_EQ(fe_only.wait(60), 0) << fe_only.logs();
+  SolidCoupledRun coupled(strip_cantilever("solid-strip-coupled"));
+  ASSERT_EQ(coupled.wait(60), 0) << coupled.logs();
+  const Eigen::Vector3d a = fe_only.final_monitor("free_edge_midpoints").col(0);
+  const Eigen::Vector3d b = coupled.final_monitor("free_edge_midpoints").col(0);
+  const double deflection = a.y();
+  EXPECT_GT(deflection, 1e-6);
+  EXPECT_NEAR(b.y(), deflection, 5e-3 * deflection) << "coupled " << b.y() << " m, FE-only " << deflection << " m";
+  EXPECT_EQ(b.z(), 0.0);
+  std::printf("2D strip tip at 10 ms: FE-only %.6g m, coupled %.6g m (%+.3f %%)\n", deflection, b.y(),
+              100 * (b.y() / deflection - 1));
+}
+
+}  // namespace
+}  // namespace valvefsi::solid::testing

@@ -1,0 +1,161 @@
+// Brick dynamics with known answers: cantilever convergence to beam theory, no volumetric
+// locking at nu = 0.4999, energy balance of a free vibration, the stable step against the
+// measured instability limit, save/restore.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "hex_test_meshes.hpp"
+#include "valvefsi/solid/hexahedron_solver.hpp"
+
+namespace valvefsi::solid {
+namespace {
+
+using testing::box_mesh;
+
+constexpr double kLength = 0.01, kThickness = 0.001, kWidth = 0.001;
+
+struct Cantilever {
+  Mesh mesh;
+  std::unique_ptr<HexahedronSolver> solver;
+};
+
+// Beam along x clamped at x = 0, one brick through the thickness (z) and the width (y).
+Cantilever cantilever(int elements, SolidMaterial material, double damping, bool plane_strain) {
+  Cantilever c;
+  c.mesh = box_mesh(kLength, kWidth, kThickness, elements, 1, 1);
+  HexahedronSolverOptions options;
+  options.mass_damping_per_s = damping;
+  c.solver = std::make_unique<HexahedronSolver>(
+      build_hexahedron_model(c.mesh, {1100.0, c.mesh.node_sets.at("x0")}, "cantilever"), std::move(material), options);
+  if (plane_strain) {
+    std::vector<SymmetryConstraint> all;
+    for (Eigen::Index n = 0; n < c.mesh.nodes.cols(); ++n) all.push_back({n, Eigen::Vector3d::UnitY()});
+    c.solver->add_symmetry_constraints(all);
+  }
+  return c;
+}
+
+// Static tip deflection under a tip load P (down, -z) by damped dynamics.
+double tip_deflection(Cantilever& c, double load, double end_time) {
+  Eigen::Matrix3Xd forces = Eigen::Matrix3Xd::Zero(3, c.mesh.nodes.cols());
+  const auto& tip = c.mesh.node_sets.at("x1");
+  for (const auto n : tip) forces(2, n) = -load / static_cast<double>(tip.size());
+  c.solver->advance_window(end_time, &forces);
+  double w = 0;
+  for (const auto n : tip) w += c.solver->displacement()(2, n);
+  return -w / static_cast<double>(tip.size());
+}
+
+// Timoshenko cantilever: PL^3 / (3 E I) + P L / (5/6 G A).
+double beam_deflection(double load, double E, double G) {
+  const double I = kWidth * std::pow(kThickness, 3) / 12.0, A = kWidth * kThickness;
+  return load * std::pow(kLength, 3) / (3.0 * E * I) + load * kLength / (5.0 / 6.0 * G * A);
+}
+
+TEST(HexahedronCantilever, ConvergesToBeamTheory) {
+  // Saint Venant-Kirchhoff with nu = 0 (plane stress = plane strain), E = 1 MPa; deflection ~1 % of L.
+  const double E = 1e6, load = 2.5e-5;
+  const double expected = beam_deflection(load, E, E / 2.0);
+  std::vector<double> errors;
+  for (const int n : {5, 10, 20}) {
+    Cantilever c = cantilever(n, SolidSaintVenantKirchhoff(E, 0.0), 600.0, false);
+    const double w = tip_deflection(c, load, 0.08);
+    errors.push_back(w / expected - 1.0);
+    std::printf("cantilever %2d x 1 x 1 bricks: tip %.5g mm, beam %.5g mm, error %+.2f %%, hourglass/strain %.3f\n",
+                n, w * 1e3, expected * 1e3, 100 * errors.back(),
+                c.solver->state().energy.hourglass_energy / c.solver->state().energy.strain_energy);
+    EXPECT_LT(c.solver->state().velocity.norm(), 1e-3 * w / 0.01);  // at rest
+  }
+  EXPECT_LT(std::abs(errors[2]), 0.02);
+  EXPECT_LT(std::abs(errors[2]), std::abs(errors[0]));
+}
+
+TEST(HexahedronCantilever, NearlyIncompressiblePlaneStrainDoesNotLock) {
+  // nu = 0.4999 (kappa = 5000 mu), plane strain: E' = 2 mu / (1 - nu), shear modulus mu.
+  // A fully integrated trilinear brick locks here (tip deflection a small fraction of this).
+  const double mu = 1e5, kappa = 5000.0 * mu, load = 1e-5;
+  const double nu = (3 * kappa - 2 * mu) / (2 * (3 * kappa + mu));
+  const double expected = beam_deflection(load, 2 * mu / (1 - nu), mu);
+  Cantilever c = cantilever(10, SolidNeoHookean(mu, kappa), 400.0, true);
+  const double w = tip_deflection(c, load, 0.06);
+  std::printf("nu = %.4f plane-strain cantilever 10 bricks: tip %.5g mm, beam %.5g mm, error %+.2f %%\n", nu, w * 1e3,
+              expected * 1e3, 100 * (w / expected - 1));
+  EXPECT_NEAR(w / expected, 1.0, 0.04);
+}
+
+TEST(HexahedronDynamics, UndampedFreeVibrationConservesEnergy) {
+  // MHGO cantilever (reference Table 1, kappa = 2/D) released with a bending velocity field.
+  Cantilever c = cantilever(10, SolidMhgo(), 0.0, false);
+  Eigen::Matrix3Xd v = Eigen::Matrix3Xd::Zero(3, c.mesh.nodes.cols());
+  for (Eigen::Index n = 0; n < v.cols(); ++n) v(2, n) = 0.5 * std::pow(c.mesh.nodes(0, n) / kLength, 2);
+  c.solver->set_velocity(v);
+  double largest_error = 0;
+  for (int window = 1; window <= 20; ++window) {
+    c.solver->advance_window(window * 5e-4);
+    largest_error = std::max(largest_error, c.solver->state().energy.relative_balance_error());
+  }
+  const auto& e = c.solver->state().energy;
+  std::printf("free vibration 10 ms, %lld steps: balance error %.2e (largest %.2e), KE %.3e J, strain %.3e J, "
+              "hourglass energy %.3e J (work %.3e J), internal work %.3e J\n",
+              static_cast<long long>(c.solver->state().step), e.relative_balance_error(), largest_error, e.kinetic,
+              e.strain_energy, e.hourglass_energy, e.hourglass_work, e.internal_work);
+  EXPECT_LT(largest_error, 1e-2);
+  EXPECT_NEAR(e.internal_work, e.strain_energy + e.hourglass_energy, 1e-2 * e.initial_kinetic);
+  EXPECT_GT(e.hourglass_energy, 0.0);  // one brick through the thickness bends through its hourglass modes
+}
+
+TEST(HexahedronDynamics, StableStepEstimateIsBelowTheMeasuredLimit) {
+  // Free, distorted block with random velocities: run 3000 steps at dt = f x the estimated critical
+  // step; the estimate (f = 1) must be stable, and the first unstable f tells how conservative it is.
+  for (const double kappa : {1e6, 1e8}) {
+    const Mesh mesh = box_mesh(0.004, 0.002, 0.001, 4, 2, 2, 0.3);
+    std::mt19937 rng(1);
+    std::normal_distribution<double> g(0.0, 1e-3);
+    Eigen::Matrix3Xd v = Eigen::Matrix3Xd::NullaryExpr(3, mesh.nodes.cols(), [&] { return g(rng); });
+    const auto unstable = [&](double factor) {
+      HexahedronSolver solver(build_hexahedron_model(mesh, {1100.0, {}}, "block"), SolidNeoHookean(1e5, kappa));
+      solver.set_step_factor_for_testing(factor);
+      solver.set_velocity(v);
+      solver.advance_window(0.0);
+      const double dt = solver.state().stable_step;
+      solver.advance_window(3000 * dt);
+      return !(solver.state().energy.kinetic < 1e3 * solver.state().energy.initial_kinetic);
+    };
+    EXPECT_FALSE(unstable(1.0)) << "kappa " << kappa;
+    double limit = 0;
+    for (double f = 1.05; f < 4.0; f += 0.05) {
+      bool blew_up = false;
+      try {
+        blew_up = unstable(f);
+      } catch (const MaterialStateError&) {
+        blew_up = true;
+      }
+      if (blew_up) {
+        limit = f;
+        break;
+      }
+    }
+    std::printf("kappa/mu = %g: instability at %.2f x the estimated critical step\n", kappa / 1e5, limit);
+    EXPECT_GT(limit, 1.0);
+    EXPECT_LT(limit, 3.0);
+  }
+}
+
+TEST(HexahedronDynamics, RestoreReplaysTheSameSteps) {
+  Cantilever c = cantilever(5, SolidOgden(OgdenParameters{}, 2e7), 0.0, false);
+  Eigen::Matrix3Xd forces = Eigen::Matrix3Xd::Zero(3, c.mesh.nodes.cols());
+  for (const auto n : c.mesh.node_sets.at("x1")) forces(2, n) = -1e-4;
+  c.solver->advance_window(1e-3, &forces);
+  const HexahedronState saved = c.solver->state();
+  c.solver->advance_window(2e-3, &forces);
+  const Eigen::Matrix3Xd first = c.solver->state().position;
+  c.solver->restore(saved);
+  c.solver->advance_window(2e-3, &forces);
+  EXPECT_EQ((c.solver->state().position - first).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_DOUBLE_EQ(c.solver->state().time, 2e-3);
+}
+
+}  // namespace
+}  // namespace valvefsi::solid

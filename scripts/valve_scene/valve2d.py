@@ -109,6 +109,12 @@ def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None 
     mesh.node_sets["free_edge"] = both_layers(free)
     mesh.node_sets["free_edge_midpoints"] = np.array(free, dtype=np.int64)
     mesh.node_sets["triangle_nodes"] = np.arange(2 * count, dtype=np.int64)
+    # the stent faces as rigid contact planes (as the 3D cases' contact cylinder: the face half a
+    # thickness outside the attachment, so the mid-surface stays within |y| <= R): without them
+    # nothing stops a 2D leaflet under FE-only pressure from swinging through the wall
+    face = p.annulus_radius + 0.5 * p.thickness
+    mesh.contact_planes["stent_upper"] = (np.array([0.0, face, 0.0]), np.array([0.0, -1.0, 0.0]))
+    mesh.contact_planes["stent_lower"] = (np.array([0.0, -face, 0.0]), np.array([0.0, 1.0, 0.0]))
     per_leaflet = 2 * segments
     for k in range(LEAFLETS_2D):
         mesh.node_sets[f"leaflet_{k}"] = both_layers(np.arange(k * n, (k + 1) * n))

@@ -88,6 +88,15 @@ class StripMesh(unittest.TestCase):
                 self.assertEqual(len(ids), 2 * n)
                 self.assertTrue(np.all(np.sign(mesh.nodes[ids, 1]) == (1 if k == 0 else -1)))
 
+    def test_stent_faces_are_contact_planes_the_leaflets_start_clear_of(self):
+        for mesh in self.meshes.values():
+            self.assertEqual(sorted(mesh.contact_planes), ["stent_lower", "stent_upper"])
+            free = np.setdiff1d(np.arange(len(mesh.nodes)), mesh.node_sets["attachment"])
+            for point, normal in mesh.contact_planes.values():
+                gap = (mesh.nodes - point) @ normal - 0.5 * P.thickness
+                self.assertTrue(np.all(gap[free] > 0))
+                self.assertAlmostEqual(gap[mesh.node_sets["attachment"]].min(), 0.0, delta=1e-12)
+
     def test_file_round_trip(self):
         mesh = self.meshes["coarse"]
         with tempfile.TemporaryDirectory() as tmp:

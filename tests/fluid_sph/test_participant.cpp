@@ -1,0 +1,132 @@
+// fluid_sph as the fluid participant, through the real coupler, against a 2D stand-in solid
+// (one rigid leaflet, tests/fluid_sph/standin_solid_leaflet_2d.cpp) built into a partition
+// of a tank: water 0.1 m deep on its left, 0.05 m on its right. The leaflet then carries the
+// hydrostatic difference F_x = rho g (hL^2 - hR^2) / 2 per metre of depth, the coupler's
+// force series must show the fluid's total equal to the solid's, and a solid that dies
+// mid-run must stop the fluid with a message and a nonzero exit.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <numeric>
+#include <regex>
+
+#include "coupled_run.hpp"
+#include "process_harness.hpp"
+
+namespace {
+
+using valvefsi::testing::ChildProcess;
+
+constexpr double kRho = 1000.0, kG = 9.81, kLeft = 0.1, kRight = 0.05;
+
+struct Processes {
+  std::filesystem::path dir;
+  std::unique_ptr<ChildProcess> coupler, solid, fluid;
+};
+
+Processes start(const std::string& name, double end_time, const std::vector<std::string>& solid_extra) {
+  Processes r;
+  r.dir = valvefsi::testing::fresh_directory(name);
+  const auto case_file = r.dir / "case.textproto";
+  valvefsi::testing::write_file(case_file, fmt::format(R"(run {{ end_time: {} output_dir: "{}" dimension: 2 series_interval: 0.01 }}
+fluid {{
+  particle_spacing: 0.005
+  density: 1000
+  dynamic_viscosity: 0.001
+  sound_speed: 20
+  artificial_viscosity: 0.02
+  gravity: [0, -9.81]
+  domain_lower: [-0.03, -0.03]
+  domain_upper: [0.13, 0.3]
+  fluid_blocks {{ box {{ lower: [0, 0] upper: [0.05, {}] }} }}
+  fluid_blocks {{ box {{ lower: [0.05, 0] upper: [0.1, {}] }} }}
+  walls {{ container {{ lower: [0, 0] upper: [0.1, 10] }} }}
+  thin_walls {{ }}
+}}
+coupling {{
+  scheme: SERIAL_EXPLICIT
+  window_size: 1e-4
+  mapping: NEAREST_PROJECTION
+  endpoint: "ipc://{}/c.ipc"
+  heartbeat_interval_s: 0.1
+  peer_timeout_s: 3
+  startup_timeout_s: 60
+}}
+)",
+                                                       end_time, r.dir.string(), kLeft, kRight, r.dir.string()));
+  const std::vector<std::string> common = {"--case", case_file.string(), "--output", r.dir.string()};
+  auto with = [&](std::vector<std::string> argv, const std::vector<std::string>& extra) {
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    argv.insert(argv.end(), common.begin(), common.end());
+    return argv;
+  };
+  r.coupler = std::make_unique<ChildProcess>(with({valvefsi::testing::coupler_exe()}, {}), r.dir / "coupler.log");
+  // The leaflet stands in the partition x = 0.05 from inside the bottom wall to above the water.
+  std::vector<std::string> solid_args = {"--x", "0.05", "--y0", "-0.01", "--y1", "0.14", "--nodes", "31", "--average-from", "0.1"};
+  solid_args.insert(solid_args.end(), solid_extra.begin(), solid_extra.end());
+  r.solid = std::make_unique<ChildProcess>(with({VALVEFSI_TEST_LEAFLET_SOLID}, solid_args), r.dir / "solid.log");
+  // The fluid learns that it is coupled from the launcher's environment variable.
+  r.fluid = std::make_unique<ChildProcess>(with({VALVEFSI_TEST_FLUID_SPH}, {"--threads", "1"}), r.dir / "fluid.log",
+                                           std::vector<std::string>{"VALVEFSI_COUPLER_ENDPOINT=ipc://" + r.dir.string() + "/c.ipc"});
+  return r;
+}
+
+double mean_received_x(const std::string& solid_log) {
+  static const std::regex pattern(R"(mean received force = ([-+0-9.eE]+) )");
+  std::smatch match;
+  if (!std::regex_search(solid_log, match, pattern)) throw std::runtime_error("no mean force in the solid's log:\n" + solid_log);
+  return std::stod(match[1].str());
+}
+
+TEST(FluidParticipant, LeafletCarriesHydrostaticDifferenceThroughTheCoupler) {
+  Processes r = start("fluid_participant_hydrostatic", 0.3, {});
+  const auto fluid_code = r.fluid->wait_for_exit(std::chrono::seconds(240));
+  const auto solid_code = r.solid->wait_for_exit(std::chrono::seconds(20));
+  const auto coupler_code = r.coupler->wait_for_exit(std::chrono::seconds(20));
+  ASSERT_TRUE(fluid_code && solid_code && coupler_code) << r.fluid->log_text();
+  EXPECT_EQ(*fluid_code, 0) << r.fluid->log_text();
+  EXPECT_EQ(*solid_code, 0) << r.solid->log_text();
+  EXPECT_EQ(*coupler_code, 0) << r.coupler->log_text();
+
+  // Conservation through the coupler: per window the solid receives the fluid's total force.
+  const auto series = r.dir / "coupling_series.h5";
+  const auto fluid_force = valvefsi::testing::read_series(series, "force_fluid");
+  const auto solid_force = valvefsi::testing::read_series(series, "force_solid");
+  ASSERT_EQ(fluid_force.size(), solid_force.size());
+  ASSERT_GE(fluid_force.size(), 3u * 2900u);
+  double worst = 0, scale = 0;
+  for (std::size_t i = 0; i < fluid_force.size(); ++i) {
+    worst = std::max(worst, std::abs(fluid_force[i] - solid_force[i]));
+    scale = std::max(scale, std::abs(fluid_force[i]));
+  }
+  EXPECT_LT(worst, 1e-9 * scale);
+
+  // Physics: the water pushes the leaflet towards the shallow side with the hydrostatic
+  // difference (per metre of depth), window average over 0.1-0.3 s.
+  const double expected = 0.5 * kRho * kG * (kLeft * kLeft - kRight * kRight);
+  const double received = mean_received_x(r.solid->log_text());
+  std::printf("leaflet force: %.3f N/m received, %.3f N/m hydrostatic (%+.2f %%)\n", received, expected,
+              100.0 * (received / expected - 1.0));
+  EXPECT_NEAR(received, expected, 0.1 * expected);
+  EXPECT_NE(r.fluid->log_text().find("0 leaks"), std::string::npos) << r.fluid->log_text();
+}
+
+TEST(FluidParticipant, DeadSolidStopsTheFluidWithAMessage) {
+  Processes r = start("fluid_participant_dead_solid", 0.3, {"--exit-at-window", "30"});
+  const auto solid_code = r.solid->wait_for_exit(std::chrono::seconds(120));
+  const auto fluid_code = r.fluid->wait_for_exit(std::chrono::seconds(60));
+  const auto coupler_code = r.coupler->wait_for_exit(std::chrono::seconds(20));
+  ASSERT_TRUE(solid_code && fluid_code && coupler_code) << r.fluid->log_text();
+  EXPECT_EQ(*solid_code, 7);
+  EXPECT_NE(*fluid_code, 0) << r.fluid->log_text();
+  EXPECT_NE(*coupler_code, 0);
+  const std::string log = r.fluid->log_text();
+  EXPECT_NE(log.find("solid"), std::string::npos) << log;
+  std::printf("fluid exit code %d; its last words:\n%s\n", *fluid_code, log.substr(log.size() > 400 ? log.size() - 400 : 0).c_str());
+}
+
+}  // namespace

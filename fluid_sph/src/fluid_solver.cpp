@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -28,7 +29,12 @@ void check_settings(const FluidSettings<D>& s) {
 
 template <int D>
 struct FluidSolver<D>::Checkpoint {
+  // Everything a step reads, as it was: the particles in their order (with their rates and
+  // scratch), the grid whose cell ranges match that order, and the near-surface flags. Nothing
+  // is re-sorted or re-evaluated on restore, so a repeated window is bit-for-bit the first.
   Particles<D> particles;
+  std::optional<CellGrid<D>> grid;
+  std::vector<std::uint8_t> near_surface;
   std::vector<PressurePlate<D>> plates;
   std::vector<Vec<D>> body_forces, body_acceleration;
   double time = 0.0, dt = 0.0;
@@ -110,6 +116,8 @@ void FluidSolver<D>::save_checkpoint() {
   if (!checkpoint_) checkpoint_ = std::make_shared<Checkpoint>();
   auto& c = *checkpoint_;
   c.particles = particles_;
+  c.grid = grid_;
+  c.near_surface = near_surface_;
   c.plates = plates_;
   c.body_forces = body_forces_;
   c.body_acceleration = body_acceleration_;
@@ -128,6 +136,8 @@ void FluidSolver<D>::restore_checkpoint() {
   if (!checkpoint_) throw std::logic_error("FluidSolver::restore_checkpoint: no checkpoint was saved");
   const auto& c = *checkpoint_;
   particles_ = c.particles;
+  grid_ = *c.grid;
+  near_surface_ = c.near_surface;
   plates_ = c.plates;
   body_forces_ = c.body_forces;
   body_acceleration_ = c.body_acceleration;
@@ -138,14 +148,7 @@ void FluidSolver<D>::restore_checkpoint() {
   lost_density_ = c.lost_density;
   max_speed_ = c.max_speed;
   max_acceleration_ = c.max_acceleration;
-  // The saved particles are already in cell order; sorting again rebuilds the grid's cell
-  // ranges and the pair-loop scratch without changing the order.
-  grid_.sort(particles_);
-  if (surface_) {
-    surface_->restore_checkpoint();
-    classify_surface();
-  }
-  evaluate_rates();
+  if (surface_) surface_->restore_checkpoint();
 }
 
 template <int D>

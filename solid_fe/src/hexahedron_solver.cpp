@@ -114,7 +114,7 @@ HexahedronSolver::HexahedronSolver(HexahedronModel model, SolidMaterial material
     *m = Eigen::Matrix3Xd::Zero(3, n);
   }
   const double mu = shear_modulus(material_), kappa = bulk_modulus(material_);
-  state_.moduli.assign(model_.elements.size(), HexModuli{hex_bending_modulus(mu, kappa), mu});
+  state_.moduli.assign(model_.elements.size(), hex_moduli(mu, kappa));
 }
 
 void HexahedronSolver::set_pressure(std::function<double(double)> pressure_Pa, std::vector<PressureFace> faces) {
@@ -366,6 +366,13 @@ void HexahedronSolver::advance_window(double t_end, const Eigen::Matrix3Xd* noda
 
 void HexahedronSolver::element_fields(Eigen::VectorXd& max_principal_stress,
                                       Eigen::VectorXd& max_principal_log_strain) const {
+  // The largest of the centre (3D law at the F-bar F) and the centres of the faces zeta = -1, +1,
+  // the leaflet's free surfaces: there the full trilinear gradient gives the in-plane C2 in the
+  // material frame, evaluated with the sheet's plane-stress law (sigma33 = 0, as the shell's outer
+  // thickness points), so a one-brick-thick leaflet reports its bending strain and stress.
+  static const std::array<Eigen::Matrix<double, 3, 8>, 2> faces{hex_shape_derivatives(Eigen::Vector3d(0, 0, -1)),
+                                                                hex_shape_derivatives(Eigen::Vector3d(0, 0, 1))};
+  const Material sheet = plane_stress_form(material_);
   const auto num_elements = static_cast<Eigen::Index>(model_.elements.size());
   max_principal_stress.resize(num_elements);
   max_principal_log_strain.resize(num_elements);
@@ -378,9 +385,26 @@ void HexahedronSolver::element_fields(Eigen::VectorXd& max_principal_stress,
             const HexKinematics k = hex_kinematics(el, state_.position);
             Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
             eig.computeDirect(hex_cauchy_stress(el, law, k.F), Eigen::EigenvaluesOnly);
-            max_principal_stress(e) = eig.eigenvalues().maxCoeff();
+            double stress = eig.eigenvalues().maxCoeff();
             eig.computeDirect(k.F.transpose() * k.F, Eigen::EigenvaluesOnly);
-            max_principal_log_strain(e) = 0.5 * std::log(eig.eigenvalues().maxCoeff());
+            double strain = 0.5 * std::log(eig.eigenvalues().maxCoeff());
+            Eigen::Matrix<double, 3, 8> X;
+            for (int a = 0; a < 8; ++a) X.col(a) = model_.reference_positions.col(el.nodes[static_cast<std::size_t>(a)]);
+            const Eigen::Matrix<double, 3, 2> in_plane = el.material_axes.leftCols<2>();
+            for (const auto& dN : faces) {
+              const Eigen::Matrix<double, 3, 8> gradient = (X * dN.transpose()).inverse().transpose() * dN;
+              const Eigen::Matrix<double, 3, 2> F2 = k.x * gradient.transpose() * in_plane;
+              const Eigen::Matrix2d C2 = F2.transpose() * F2;
+              const PlaneStressResponse r = plane_stress(sheet, C2, false);
+              // Cauchy stress F2 S F2^T / J shares its non-zero eigenvalues with S C2 / J, J = lambda3 sqrt(det C2).
+              const Eigen::Matrix2d M = r.stress * C2 / (r.thickness_stretch * std::sqrt(C2.determinant()));
+              const double half_trace = 0.5 * M.trace();
+              stress = std::max(stress, half_trace + std::sqrt(std::max(0.0, half_trace * half_trace - M.determinant())));
+              const double c_half = 0.5 * C2.trace();
+              strain = std::max(strain, 0.5 * std::log(c_half + std::sqrt(std::max(0.0, c_half * c_half - C2.determinant()))));
+            }
+            max_principal_stress(e) = stress;
+            max_principal_log_strain(e) = strain;
           } catch (const MaterialStateError&) {
             max_principal_stress(e) = std::numeric_limits<double>::quiet_NaN();
             max_principal_log_strain(e) = std::numeric_limits<double>::quiet_NaN();

@@ -33,7 +33,7 @@ Assembled assemble(const HexahedronModel& model, const SolidMaterial& material, 
   std::visit(
       [&](const auto& law) {
         for (const auto& el : model.elements) {
-          HexModuli m = fixed_moduli ? *fixed_moduli : HexModuli{hex_bending_modulus(mu, kappa), mu};
+          HexModuli m = fixed_moduli ? *fixed_moduli : hex_moduli(mu, kappa);
           const auto r = hex_element_force(el, law, x, model.density, m, false, out.force);
           out.strain_energy += r.strain_energy;
           out.hourglass_energy += r.hourglass_energy;
@@ -227,7 +227,7 @@ TEST(HexahedronElement, ForceIsTheGradientOfTheEnergy) {
   std::uniform_real_distribution<double> u(-0.15e-3, 0.15e-3);
   for (Eigen::Index n = 0; n < distorted.nodes.cols(); ++n) distorted.nodes.col(n) += Eigen::Vector3d(u(rng), u(rng), 0.3 * u(rng));
   const HexahedronModel model = model_of(distorted);
-  for (const HexModuli none : {HexModuli{0.0, 0.0}, HexModuli{3e6, 1e6}})
+  for (const HexModuli none : {HexModuli{0.0, 0.0}, HexModuli{3e6, 1e6, 0.4}})
   for (const auto& material : all_laws(1e6)) {
     Eigen::Matrix3Xd x = deformed(distorted, random_stretch(rng, 0.08));
     for (Eigen::Index n = 0; n < x.cols(); ++n) x.col(n) += Eigen::Vector3d(u(rng), u(rng), u(rng)) * 0.3;
@@ -282,6 +282,32 @@ TEST(HexahedronHourglass, RectangularBrickBendsExactlyAndEveryModeIsResisted) {
       EXPECT_GT(r.hourglass_energy, 1e3 * std::abs(r.strain_energy)) << "mode " << mode << " component " << comp;
     }
   }
+}
+
+TEST(HexahedronFields, SurfaceStrainOfABentBrickAndStressOfAStretchedOne) {
+  // Pure bending by curvature k of a brick 2c thick: the surface log strain is ~ k c (centre ~ 0);
+  // uniaxial strain of a neo-Hookean block: every point reports log(stretch).
+  const double a = 2e-3, c = 0.25e-3, k = 20.0;
+  Mesh mesh = box_mesh(2 * a, 2 * a, 2 * c, 1, 1, 1);
+  mesh.nodes.colwise() -= Eigen::Vector3d(a, a, c);
+  HexahedronSolver solver(model_of(mesh), SolidSaintVenantKirchhoff(1e6, 0.0));
+  HexahedronState state = solver.state();
+  for (Eigen::Index n = 0; n < 8; ++n) {
+    const Eigen::Vector3d X = mesh.nodes.col(n);
+    state.position.col(n) = X + Eigen::Vector3d(k * X.x() * X.z(), 0.0, -0.5 * k * X.x() * X.x());
+  }
+  solver.restore(state);
+  Eigen::VectorXd stress, strain;
+  solver.element_fields(stress, strain);
+  EXPECT_NEAR(strain(0), k * c, 0.05 * k * c);
+  EXPECT_NEAR(stress(0), 1e6 * k * c, 0.1 * 1e6 * k * c);
+
+  for (Eigen::Index n = 0; n < 8; ++n) state.position.col(n) = mesh.nodes.col(n).cwiseProduct(Eigen::Vector3d(1.1, 1, 1));
+  solver.restore(state);
+  solver.element_fields(stress, strain);
+  EXPECT_NEAR(strain(0), std::log(1.1), 1e-12);
+  // SVK nu = 0, uniaxial strain: sigma11 = lambda S11 lambda / J = E E11 lambda.
+  EXPECT_NEAR(stress(0), 1e6 * 0.5 * (1.21 - 1) * 1.1, 1e-6);
 }
 
 TEST(HexahedronLoads, PressureFacesCarryPressureTimesAreaAndPickTheOuterSurface) {

@@ -32,7 +32,14 @@ struct HexElement {
   Eigen::Matrix<double, 3, 4> bending_factor;   // k_i,alpha per unit bending modulus E' (m^3 / m^2)
   Eigen::Matrix<double, 3, 4> shear_factor;     // k_i,alpha per unit shear modulus
   Eigen::Vector4d hourglass_norm2;              // |gamma_alpha|^2
+  // Poisson coupling of the two bending modes whose normal strains vary along natural axis m
+  // (plate energy 2 nu eps_x eps_y): sqrt of the product of their bending factors.
+  Eigen::Vector3d coupling_factor = Eigen::Vector3d::Zero();
 };
+
+// The two (component i, mode alpha) bending modes coupled for each varying axis m = xi, eta, zeta.
+inline constexpr std::array<std::array<std::array<int, 2>, 2>, 3> kCoupledBendingModes{
+    {{{{1, 0}, {2, 2}}}, {{{0, 0}, {2, 1}}}, {{{0, 2}, {1, 1}}}}};
 
 // Moduli an element's hourglass control uses: the material's small-strain values, kept fixed so
 // that the hourglass forces stay conservative (a modulus that follows the state, updated every
@@ -40,6 +47,7 @@ struct HexElement {
 struct HexModuli {
   double bending = 0.0;  // E' (Pa)
   double shear = 0.0;    // mu (Pa)
+  double poisson = 0.0;  // nu, couples the bending modes
 };
 
 // Natural coordinates of the nodes: 0-3 the bottom face (zeta = -1) counter-clockwise seen from +zeta.
@@ -70,6 +78,11 @@ inline Eigen::Matrix3d hex_natural_frame(const Eigen::Matrix3d& g) {
 // E' of a rectangular brick's bending hourglass mode (plane-strain E/(1 - nu^2) in K and mu).
 inline double hex_bending_modulus(double shear_modulus, double bulk_modulus) {
   return 4.0 * shear_modulus * (3.0 * bulk_modulus + shear_modulus) / (3.0 * bulk_modulus + 4.0 * shear_modulus);
+}
+
+inline HexModuli hex_moduli(double shear_modulus, double bulk_modulus) {
+  return {hex_bending_modulus(shear_modulus, bulk_modulus), shear_modulus,
+          (3.0 * bulk_modulus - 2.0 * shear_modulus) / (2.0 * (3.0 * bulk_modulus + shear_modulus))};
 }
 
 // The uniform deformation of a brick: Fbar, the F-bar F, and the volume data.
@@ -164,6 +177,7 @@ HexElementResult hex_element_force(const HexElement& el, const Law& law, const E
       for (int a = 0; a < 4; ++a) {
         sum += (moduli.bending * el.bending_factor(i, a) + moduli.shear * el.shear_factor(i, a)) * el.hourglass_norm2(a);
       }
+      sum += moduli.bending * std::abs(moduli.poisson) * el.coupling_factor.maxCoeff() * el.hourglass_norm2.maxCoeff();
       hourglass_stiffness = std::max(hourglass_stiffness, sum);
     }
     result.omega2 = 8.0 / (density * el.volume) *
@@ -174,16 +188,24 @@ HexElementResult hex_element_force(const HexElement& el, const Law& law, const E
   // natural frame R(g_xi, g_eta) with the nodes (without it the forces are not conservative and
   // pump energy into a bending brick that rotates).
   Eigen::Matrix<double, 3, 8> f_hourglass = Eigen::Matrix<double, 3, 8>::Zero();
-  Eigen::Matrix3d w = Eigen::Matrix3d::Zero();  // column i: sum_alpha Q_i,alpha q_alpha
+  Eigen::Matrix3d w = Eigen::Matrix3d::Zero();  // column i: sum_alpha T_i,alpha q_alpha
+  Eigen::Matrix<double, 3, 4> q, q_local, T;      // hourglass vectors, local, generalised stresses
   for (int a = 0; a < 4; ++a) {
-    const Eigen::Vector3d q = k.x * el.hourglass.row(a).transpose();
-    const Eigen::Vector3d q_local = R.transpose() * q;
-    const Eigen::Vector3d stiffness =
-        moduli.bending * el.bending_factor.col(a) + moduli.shear * el.shear_factor.col(a);
-    const Eigen::Vector3d Q_local = stiffness.cwiseProduct(q_local);
-    result.hourglass_energy += 0.5 * Q_local.dot(q_local);
-    f_hourglass += (R * Q_local) * el.hourglass.row(a);
-    w += q * Q_local.transpose();
+    q.col(a) = k.x * el.hourglass.row(a).transpose();
+    q_local.col(a) = R.transpose() * q.col(a);
+    T.col(a) = (moduli.bending * el.bending_factor.col(a) + moduli.shear * el.shear_factor.col(a))
+                   .cwiseProduct(q_local.col(a));
+  }
+  for (int m = 0; m < 3; ++m) {
+    const auto& [first, second] = kCoupledBendingModes[static_cast<std::size_t>(m)];
+    const double c = moduli.bending * moduli.poisson * el.coupling_factor(m);
+    T(first[0], first[1]) += c * q_local(second[0], second[1]);
+    T(second[0], second[1]) += c * q_local(first[0], first[1]);
+  }
+  for (int a = 0; a < 4; ++a) {
+    result.hourglass_energy += 0.5 * T.col(a).dot(q_local.col(a));
+    f_hourglass += (R * T.col(a)) * el.hourglass.row(a);
+    w += q.col(a) * T.col(a).transpose();
   }
   {
     const auto skew = [](const Eigen::Vector3d& v) {

@@ -167,10 +167,12 @@ class SolidOgden {
 class SolidSaintVenantKirchhoff {
  public:
   SolidSaintVenantKirchhoff(double youngs_modulus_Pa, double poisson_ratio)
-      : mu_(youngs_modulus_Pa / (2.0 * (1.0 + poisson_ratio))),
+      : E_(youngs_modulus_Pa), nu_(poisson_ratio), mu_(youngs_modulus_Pa / (2.0 * (1.0 + poisson_ratio))),
         lambda_(youngs_modulus_Pa * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio))) {}
   double shear_modulus() const { return mu_; }
   double bulk_modulus() const { return lambda_ + 2.0 * mu_ / 3.0; }
+  double youngs_modulus() const { return E_; }
+  double poisson_ratio() const { return nu_; }
   SolidResponse response(const Eigen::Matrix3d& C) const {
     const Eigen::Matrix3d E = 0.5 * (C - Eigen::Matrix3d::Identity());
     SolidResponse r;
@@ -180,7 +182,7 @@ class SolidSaintVenantKirchhoff {
   }
 
  private:
-  double mu_, lambda_;
+  double E_, nu_, mu_, lambda_;
 };
 
 using SolidMaterial = std::variant<SolidOgden, SolidMhgo, SolidNeoHookean, SolidSaintVenantKirchhoff>;
@@ -201,6 +203,19 @@ inline SolidMaterial solid_material_from(const Material& m, double bulk_modulus_
     }
   };
   return std::visit(Convert{bulk_modulus_Pa}, m);
+}
+
+// The thin-sheet (plane-stress, incompressible) form of a 3D law, for the free surfaces of a brick.
+inline Material plane_stress_form(const SolidMaterial& m) {
+  struct Convert {
+    Material operator()(const SolidOgden& law) const { return Ogden(law.parameters()); }
+    Material operator()(const SolidMhgo& law) const { return Mhgo(law.parameters()); }
+    Material operator()(const SolidNeoHookean& law) const { return NeoHookean(law.shear_modulus()); }
+    Material operator()(const SolidSaintVenantKirchhoff& law) const {
+      return SaintVenantKirchhoff(law.youngs_modulus(), law.poisson_ratio());
+    }
+  };
+  return std::visit(Convert{}, m);
 }
 
 inline double bulk_modulus(const SolidMaterial& m) {

@@ -107,7 +107,8 @@ class HexahedronSolver {
   const HexahedronSolverOptions& options() const { return options_; }
   Eigen::Matrix3Xd displacement() const { return state_.position - model_.reference_positions; }
 
-  // Per-element maximum principal Cauchy stress (Pa) and logarithmic strain of the state.
+  // Per-element maximum principal Cauchy stress (Pa) and logarithmic strain of the state: the
+  // largest of the centre and the two zeta = -1, +1 face centres (the leaflet surfaces).
   void element_fields(Eigen::VectorXd& max_principal_stress, Eigen::VectorXd& max_principal_log_strain) const;
 
   // For tests: forces the next step to use dt = factor x the critical-step estimate (safety 1).

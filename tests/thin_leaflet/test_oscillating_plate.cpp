@@ -17,6 +17,7 @@
 #include <numbers>
 
 #include "valvefsi/fluid/thin_wall/scenes_2d.hpp"
+#include "valvefsi/fluid/thin_wall/solver_run_2d.hpp"
 
 namespace valvefsi::fluid::thin_wall {
 namespace {
@@ -33,7 +34,7 @@ PlateFit run_plate(double dp, double end_time) {
   plate.period = 0.5;
   auto scene = oscillating_plate_box(dp, plate);
   scene.fluid.shifting = 1.0;  // without it the flow round the edges blows up within ~1 s
-  ThinWallFlow2D flow(std::move(scene));
+  ThinWallSolverRun2D flow(std::move(scene));
   const double w = 2 * std::numbers::pi / plate.period;
   Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
   Eigen::Vector3d rhs = Eigen::Vector3d::Zero();

@@ -11,6 +11,7 @@
 #include <cstdio>
 
 #include "valvefsi/fluid/thin_wall/scenes_2d.hpp"
+#include "valvefsi/fluid/thin_wall/solver_run_2d.hpp"
 
 namespace valvefsi::fluid::thin_wall {
 namespace {
@@ -21,7 +22,7 @@ struct Levels {
 };
 
 // Water level on each side: the fluid area over the width (particles times dp^2 / 0.5 m).
-Levels levels(const ThinWallFlow2D& flow) {
+Levels levels(const ThinWallSolverRun2D& flow) {
   const auto& p = flow.particles();
   const double dp = flow.settings().particle_spacing;
   Levels l;
@@ -36,7 +37,7 @@ Levels levels(const ThinWallFlow2D& flow) {
 }
 
 // Highest fluid particle on each side, plus dp/2 (the free surface).
-Levels surface(const ThinWallFlow2D& flow) {
+Levels surface(const ThinWallSolverRun2D& flow) {
   const auto& p = flow.particles();
   const double dp = flow.settings().particle_spacing;
   Levels l;
@@ -52,7 +53,7 @@ Levels surface(const ThinWallFlow2D& flow) {
 TEST(ThinWallTwoLevels, ClosedWallHoldsLevelsAndCarriesTheHydrostaticLoad) {
   omp_set_num_threads(1);
   const double dp = 0.025, h1 = 1.0, h2 = 0.5, rho = 1000.0, g = 9.81;
-  ThinWallFlow2D flow(two_level_tank(dp, h1, h2, 0.0));
+  ThinWallSolverRun2D flow(two_level_tank(dp, h1, h2, 0.0));
   const Levels start = levels(flow);
   flow.advance_to(0.5);
   double fx = 0, fy = 0;
@@ -86,7 +87,7 @@ TEST(ThinWallTwoLevels, GapUnderTheFreeEndEqualisesLevelsStablyWithoutLeaks) {
   const double dp = 0.025, h1 = 1.0, h2 = 0.5;
   auto scene = two_level_tank(dp, h1, h2, 0.1);
   scene.fluid.shifting = 1.0;  // keeps the particles regular in the fast flow round the edge
-  ThinWallFlow2D flow(std::move(scene));
+  ThinWallSolverRun2D flow(std::move(scene));
   const std::size_t fluid = levels(flow).left_count + levels(flow).right_count;
   double max_speed = 0, difference = 0;
   int samples = 0;

@@ -15,6 +15,20 @@ import scipy.sparse.linalg as spla
 
 
 def added_mass_ratio(b, L, H, cells_per_b):
+    return solve(b, L, H, cells_per_b)[0]
+
+
+def potential_field(b, L, H, cells_per_b):
+    """Velocity potential per unit plate velocity at the cell centres (ny x nx, mean zero),
+    plate at x = 0 moving towards +x; cell centre coordinates x, y."""
+    phi = solve(b, L, H, cells_per_b)[1]
+    h = b / cells_per_b
+    x = (np.arange(phi.shape[1]) + 0.5) * h - L / 2
+    y = (np.arange(phi.shape[0]) + 0.5) * h - H / 2
+    return phi - phi.mean(), x, y
+
+
+def solve(b, L, H, cells_per_b):
     h = b / cells_per_b
     nx = int(round(L / h))
     ny = int(round(H / h))
@@ -52,7 +66,7 @@ def added_mass_ratio(b, L, H, cells_per_b):
     mask[jlo:jhi, ip - 1] = False
     dy = np.diff(phi, axis=0)
     energy2 = (dx[mask] ** 2).sum() + (dy ** 2).sum()  # = integral |grad phi|^2 (h^2 cancels)
-    return energy2 / (U * U) / (np.pi * (b / 2) ** 2)
+    return energy2 / (U * U) / (np.pi * (b / 2) ** 2), phi
 
 
 def main():

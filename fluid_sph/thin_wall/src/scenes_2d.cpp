@@ -20,7 +20,7 @@ ThinWallCase2D two_level_tank(double dp, double left_level, double right_level, 
   c.scene.fluid.push_back({{0.0, 0.0}, {0.5, left_level}, {}, {}});
   c.scene.fluid.push_back({{0.5, 0.0}, {1.0, right_level}, {}, {}});
   const double bottom = gap > 0 ? gap : -3.0 * dp;
-  c.wall = Polyline::at_rest({{0.5, bottom}, {0.5, 1.2}});
+  c.walls.push_back(Polyline::at_rest({{0.5, bottom}, {0.5, 1.2}}));
   return c;
 }
 
@@ -43,11 +43,12 @@ ThinWallCase2D oscillating_plate_box(double dp, const OscillatingPlate& plate) {
   // Lattice offset so that the plate's line x = 0 lies half-way between particle columns.
   c.scene.lattice_origin = {0.0, 0.0};
   const double half = plate.plate_width / 2;
-  c.wall = Polyline::at_rest({{-plate.amplitude, -half}, {-plate.amplitude, half}});
+  c.walls.push_back(Polyline::at_rest({{-plate.amplitude, -half}, {-plate.amplitude, half}}));
   const double A = plate.amplitude;
-  c.motion = [A, omega, half](double t, Polyline& w) {
+  c.motion = [A, omega, half](double t, std::vector<Polyline>& walls) {
     // X = -A cos(wt): starts at rest (no impulsive start), centred after the first period.
     const double x = -A * std::cos(omega * t), v = A * omega * std::sin(omega * t), a = A * omega * omega * std::cos(omega * t);
+    Polyline& w = walls.front();
     w.position = {{x, -half}, {x, half}};
     w.velocity = {{v, 0.0}, {v, 0.0}};
     w.acceleration = {{a, 0.0}, {a, 0.0}};

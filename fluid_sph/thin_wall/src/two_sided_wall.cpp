@@ -221,17 +221,25 @@ void TwoSidedWall::add_wall_rates(Particles<2>& p) {
             beyond = (seg == 0 && along < 0.0) || (seg + 1 == wall_.segment_count() && along > 1.0);
             if (beyond && settings_.opposite_state_beyond_edge) k_state = 1 - k_side;
           }
+          bool round_edge = false;
+          if (settings_.other_side_round_edge || settings_.fluid_velocity_round_edge) {
+            for (const Vec2& e : {wall_.position.front(), wall_.position.back()})
+              round_edge = round_edge || std::hypot(xa[0] - e[0], xa[1] - e[1]) + std::hypot(xv[0] - e[0], xv[1] - e[1]) < R;
+            if (round_edge && settings_.other_side_round_edge) k_state = 1 - k_side;
+          }
+          // The virtual point stands for moving fluid, not for the wall.
+          const bool fluid_like = (beyond && settings_.fluid_velocity_beyond_edge) || (round_edge && settings_.fluid_velocity_round_edge);
           const SideState& s0 = markers_[mw.first].side[k_state];
           const SideState& s1 = markers_[mw.second].side[k_state];
           Vec2 vw = wall_.velocity_at(seg, tw);
-          if (beyond && settings_.fluid_velocity_beyond_edge)
+          if (fluid_like)
             for (int d = 0; d < 2; ++d) vw[d] = mw.w0 * s0.extrapolated_velocity[d] + mw.w1 * s1.extrapolated_velocity[d];
           const Vec2 aw = wall_.acceleration_at(seg, tw);
           double p_v = mw.w0 * s0.pressure + mw.w1 * s1.pressure;
           for (int d = 0; d < 2; ++d) p_v += rho0 * (fluid_.gravity[d] - aw[d]) * (xv[d] - q[d]);
           Vec2 vv_v;
           for (int d = 0; d < 2; ++d)
-            vv_v[d] = beyond && settings_.fluid_velocity_beyond_edge
+            vv_v[d] = fluid_like
                           ? vw[d]
                           : 2.0 * vw[d] - (mw.w0 * s0.extrapolated_velocity[d] + mw.w1 * s1.extrapolated_velocity[d]);
           const double inv_v = 1.0 / (rho0 + eos.density_excess(p_v - fluid_.background_pressure));

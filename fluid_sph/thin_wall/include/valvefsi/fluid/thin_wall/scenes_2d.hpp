@@ -1,9 +1,25 @@
 #pragma once
 // The 2D proof scenes of the thin wall (docs/thin-leaflet.md), shared by tests and the
-// experiment driver.
-#include "valvefsi/fluid/thin_wall/thin_wall_flow_2d.hpp"
+// experiment program; they run on FluidSolver<2> through ThinWallSolverRun2D.
+#include <functional>
+#include <vector>
+
+#include "valvefsi/fluid/fluid_settings.hpp"
+#include "valvefsi/fluid/geometry.hpp"
+#include "valvefsi/fluid/thin_wall/polyline.hpp"
+#include "valvefsi/fluid/thin_wall/two_sided_wall.hpp"
 
 namespace valvefsi::fluid::thin_wall {
+
+struct ThinWallCase2D {
+  FluidSettings<2> fluid;
+  ThinWallSettings wall_settings;
+  SceneGeometry<2> scene;      // rigid tank walls and fluid blocks (fill_particles)
+  std::vector<Polyline> walls;  // the thin walls (leaflets) at t = 0
+  // Prescribed motion: sets every wall's node positions and velocities at a time (the
+  // accelerations come from the model's window interpolation). Empty: the walls stay fixed.
+  std::function<void(double time, std::vector<Polyline>& walls)> motion;
+};
 
 // A 1 m wide tank of water split at x = 0.5 m by a vertical thin wall reaching 1.2 m, water
 // level left_level on the left and right_level on the right, both hydrostatic at rest.

@@ -43,6 +43,14 @@ struct ThinWallSettings {
   // continuity and viscous terms) instead of the wall's: the fluid there flows round the edge
   // and is not a wall. (A measured alternative; docs/thin-leaflet.md.)
   bool fluid_velocity_beyond_edge = false;
+  // A virtual point that the particle could reach round a free end within one kernel support
+  // (|x_a - end| + |end - x_v| < R) stands where the real fluid is the other side's: it
+  // carries the other side's state (the mirror image of the particle's own side is right
+  // only where the wall hides the other side). docs/thin-leaflet.md, "free edge".
+  bool other_side_round_edge = false;
+  // Such a virtual point moves with that side's extrapolated fluid velocity (continuity and
+  // viscous terms), not with the wall.
+  bool fluid_velocity_round_edge = false;
 };
 
 // What the model knows of one particle after classify (sorted index).

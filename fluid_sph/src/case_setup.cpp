@@ -107,6 +107,13 @@ FluidSetup<D> fluid_setup_from_case(const cases::Case& c, const std::filesystem:
     if (f.periodic().size() != D) in.fail("periodic", fmt::format("has {} entries: allowed {} or none", f.periodic().size(), D));
     for (int d = 0; d < D; ++d) s.periodic[d] = f.periodic(d);
   }
+  for (int k = 0; k < f.mirror_planes_size(); ++k) {
+    const std::string field = fmt::format("mirror_planes[{}]", k);
+    MirrorPlane<D> plane;
+    plane.point = in.vec<D>(f.mirror_planes(k).point(), field + ".point");
+    plane.normal = in.direction<D>(in.vec<D>(f.mirror_planes(k).normal(), field + ".normal"), field + ".normal");
+    s.mirror_planes.push_back(plane);
+  }
   setup.scene.lattice_origin = in.vec_or<D>(f.lattice_origin(), "lattice_origin", Vec<D>{});
   setup.wall_layers = f.wall_layers();
 

@@ -124,7 +124,7 @@ void CellGrid<D>::sort(Particles<D>& p) {
 #pragma omp for schedule(static)
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
       for (int d = 0; d < D; ++d) p.local_position[d][i] = static_cast<float>(sorted_.position[d][i] - lower_[d]);
-      p.fluid_mask[i] = sorted_.kind[i] == Kind::fluid ? 1.0f : 0.0f;
+      p.fluid_mask[i] = acts_as_fluid(sorted_.kind[i]) ? 1.0f : 0.0f;
     }
   }
   p.for_each_array_with(sorted_, [](auto& a, auto& b) { a.swap(b); });

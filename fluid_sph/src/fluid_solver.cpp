@@ -57,11 +57,77 @@ FluidSolver<D>::FluidSolver(const FluidSettings<D>& settings, Particles<D> parti
     if (particles_.body[i] > plates_.size())
       throw std::invalid_argument("fluid particles: body index " + std::to_string(particles_.body[i]) +
                                   " has no pressure plate (plates: " + std::to_string(plates_.size()) + ")");
+  for (const auto& plane : settings_.mirror_planes) {
+    double length2 = 0;
+    for (int d = 0; d < D; ++d) length2 += plane.normal[d] * plane.normal[d];
+    if (std::abs(length2 - 1.0) > 1e-9)
+      throw std::invalid_argument("fluid settings: a mirror plane's normal has length " + std::to_string(std::sqrt(length2)) +
+                                  ": allowed 1 (normalise it)");
+  }
+  refresh_mirror_images();
   lost_ = grid_.wrap_and_mark_lost(particles_);
   grid_.sort(particles_);
   if (surface_) classify_surface();
   evaluate_rates();
   choose_time_step();
+}
+
+template <int D>
+void FluidSolver<D>::refresh_mirror_images() {
+  if (settings_.mirror_planes.empty()) return;
+  auto& p = particles_;
+  // Drop last step's images (compacting every array), then mirror every fluid and wall
+  // particle within a support of a plane: x' = x - 2 d n, v' = v - 2 (v.n) n.
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (is_mirror(p.kind[i])) continue;
+    if (kept != i) p.for_each_array([&](auto& a) { a[kept] = a[i]; });
+    ++kept;
+  }
+  p.for_each_array([&](auto& a) { a.resize(kept); });
+  const double support = settings_.support_radius();
+  // A fluid particle that stepped across a plane swaps roles with its image, which stepped
+  // the other way: reflect it back (position and normal velocity), as a specular wall would.
+  for (const auto& plane : settings_.mirror_planes) {
+    for (std::size_t i = 0; i < kept; ++i) {
+      if (p.kind[i] != Kind::fluid) continue;
+      double distance = 0, normal_speed = 0;
+      for (int d = 0; d < D; ++d) {
+        distance += (p.position[d][i] - plane.point[d]) * plane.normal[d];
+        normal_speed += p.velocity[d][i] * plane.normal[d];
+      }
+      if (distance >= 0) continue;
+      for (int d = 0; d < D; ++d) {
+        p.position[d][i] -= 2.0 * distance * plane.normal[d];
+        p.velocity[d][i] = static_cast<float>(p.velocity[d][i] - 2.0 * normal_speed * plane.normal[d]);
+        p.viscous_velocity[d][i] = p.velocity[d][i];
+      }
+    }
+  }
+  const auto& lower = settings_.domain_lower;
+  const auto& upper = settings_.domain_upper;
+  for (const auto& plane : settings_.mirror_planes) {
+    for (std::size_t i = 0; i < kept; ++i) {
+      const Kind k = p.kind[i];
+      if (k != Kind::fluid && k != Kind::wall) continue;
+      double distance = 0, normal_speed = 0;
+      for (int d = 0; d < D; ++d) {
+        distance += (p.position[d][i] - plane.point[d]) * plane.normal[d];
+        normal_speed += p.velocity[d][i] * plane.normal[d];
+      }
+      if (distance < 0 || distance >= support) continue;
+      Vec<D> x{};
+      std::array<float, D> v{};
+      bool inside = true;
+      for (int d = 0; d < D; ++d) {
+        x[d] = p.position[d][i] - 2.0 * distance * plane.normal[d];
+        v[d] = static_cast<float>(p.velocity[d][i] - 2.0 * normal_speed * plane.normal[d]);
+        inside = inside && (settings_.periodic[d] || (x[d] >= lower[d] && x[d] < upper[d]));
+      }
+      if (!inside) continue;  // outside the domain: no neighbour of anything inside it
+      p.add(x, v, p.density_excess[i], k == Kind::fluid ? Kind::mirror_fluid : Kind::mirror_wall, p.body[i]);
+    }
+  }
 }
 
 template <int D>
@@ -174,7 +240,7 @@ void FluidSolver<D>::step() {
   const float half = static_cast<float>(0.5 * dt);
   const float full = static_cast<float>(dt);
   auto& p = particles_;
-  const auto n = static_cast<std::ptrdiff_t>(p.size());
+  auto n = static_cast<std::ptrdiff_t>(p.size());
   if (surface_) surface_->begin_step(p);
 
   // First kick (velocity half step, density predicted to the full step) and drift (eq. 4).
@@ -209,6 +275,8 @@ void FluidSolver<D>::step() {
     surface_->move_to(time_);
     surface_->correct_crossings(p);
   }
+  refresh_mirror_images();
+  n = static_cast<std::ptrdiff_t>(p.size());  // the mirror images changed the count
 
   lost_ += grid_.wrap_and_mark_lost(p);
   grid_.sort(p);

@@ -157,6 +157,16 @@ Particles<D> fill_particles(const SceneGeometry<D>& scene, const FluidSettings<D
       x[d] = scene.lattice_origin[d] + (static_cast<double>(first[d] + rest % count[d]) + 0.5) * dp;
       rest /= count[d];
     }
+    // Beyond a mirror plane live only images. Points closer than 0.4 dp to a plane are left
+    // out too: their images would sit almost on them (a plane on a lattice plane keeps its
+    // first layer, at dp/2).
+    bool mirrored_away = false;
+    for (const auto& plane : s.mirror_planes) {
+      double distance = 0;
+      for (int d = 0; d < D; ++d) distance += (x[d] - plane.point[d]) * plane.normal[d];
+      mirrored_away = mirrored_away || distance < 0.4 * dp;
+    }
+    if (mirrored_away) continue;
     // Plates first, then fixed walls, then fluid.
     int plate = -1;
     for (std::size_t k = 0; k < scene.plates.size() && plate < 0; ++k)

@@ -278,7 +278,7 @@ void update_fluid_pressure(Particles<D>& p, const FluidSettings<D>& s) {
   const float background = static_cast<float>(s.background_pressure);
 #pragma omp parallel for simd schedule(static)
   for (std::ptrdiff_t i = 0; i < n; ++i) {
-    if (kind[i] == Kind::fluid) {
+    if (kind[i] == Kind::fluid || kind[i] == Kind::mirror_fluid) {
       inverse[i] = 1.0f / (rho0 + excess[i]);
       pressure[i] = bulk * excess[i] * inverse[i] + background;  // eq. 5 with s = 0, Gamma0 = 0
     }
@@ -293,7 +293,7 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
   const float rho0 = static_cast<float>(s.rest_density);
   with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
     for_each_particle_with_neighbours<D>(grid, [&](std::uint32_t w, const auto& segments, int count) {
-      if (p.kind[w] != Kind::wall) return;
+      if (p.kind[w] != Kind::wall && p.kind[w] != Kind::mirror_wall) return;
       float sum_w = 0, sum_p = 0;
       float sum_rho_r[3] = {0, 0, 0}, sum_v[3] = {0, 0, 0};
       for (int sidx = 0; sidx < count; ++sidx) {
@@ -301,7 +301,7 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
         float xw[3] = {0, 0, 0};
         for (int d = 0; d < D; ++d) xw[d] = view.x[d][w] - static_cast<float>(seg.shift[d]);
         for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
-          if (view.kind[b] != Kind::fluid) continue;
+          if (!acts_as_fluid(view.kind[b])) continue;
           if (filter.active() && filter.blocked(w, b)) continue;
           float dx[3] = {0, 0, 0};
           float r2 = 0;

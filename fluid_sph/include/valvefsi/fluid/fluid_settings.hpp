@@ -2,11 +2,20 @@
 // Physical and numerical parameters of one fluid simulation (SI units throughout).
 #include <array>
 #include <limits>
+#include <vector>
 
 #include "valvefsi/fluid/kernels.hpp"
 #include "valvefsi/fluid/particles.hpp"
 
 namespace valvefsi::fluid {
+
+// A symmetry plane: the fluid lies on the side the normal points to; the other side holds the
+// fluid's mirror image (no flux through the plane, no shear stress on it).
+template <int D>
+struct MirrorPlane {
+  Vec<D> point{};   // m
+  Vec<D> normal{};  // unit, towards the fluid
+};
 
 template <int D>
 struct FluidSettings {
@@ -40,6 +49,10 @@ struct FluidSettings {
   Vec<D> domain_lower{};                // particles leaving [lower, upper) on a non-periodic axis are lost
   Vec<D> domain_upper{};
   std::array<bool, D> periodic{};
+  // Symmetry planes at any angle (e.g. the two cut faces of a valve sector). The domain must
+  // reach a kernel support beyond each plane, where the mirror images live. Images of images
+  // (near the line where two planes meet) are not made.
+  std::vector<MirrorPlane<D>> mirror_planes;
 
   double smoothing_length() const { return smoothing_length_ratio * particle_spacing; }
   double support_radius() const { return 2.0 * smoothing_length(); }

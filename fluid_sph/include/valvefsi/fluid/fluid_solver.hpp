@@ -67,6 +67,7 @@ class FluidSolver {
   void choose_time_step();
   void shift_particles(double dt);
   void classify_surface();
+  void refresh_mirror_images();
   PairFilter<D> pair_filter() const;
 
   struct Checkpoint;

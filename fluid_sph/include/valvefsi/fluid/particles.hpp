@@ -17,7 +17,15 @@ enum class Kind : std::uint8_t {
   fluid = 0,
   wall = 1,  // dummy particle of a rigid wall or moving body (generalized wall condition)
   lost = 2,  // left a non-periodic domain; excluded from all interactions and counted
+  // Mirror images across a symmetry plane, rebuilt every step from the particles within a
+  // kernel support of the plane; neighbours only, never integrated, probed or counted.
+  mirror_fluid = 3,  // acts as fluid in the pair sums (pressure from its density)
+  mirror_wall = 4,   // acts as a wall (its own wall state); no force is booked on it
 };
+
+// Whether particles of this kind enter the pair sums as fluid.
+inline bool acts_as_fluid(Kind k) { return k == Kind::fluid || k == Kind::mirror_fluid; }
+inline bool is_mirror(Kind k) { return k == Kind::mirror_fluid || k == Kind::mirror_wall; }
 
 template <int D>
 struct Particles {

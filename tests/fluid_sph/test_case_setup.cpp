@@ -72,5 +72,29 @@ TEST(CaseSetup, OutOfRangeValueIsRejectedByTheSchema) {
   EXPECT_THROW(parse_case_text(text, "channel.textproto"), CaseError);
 }
 
+TEST(CaseSetup, MirrorPlanesAreReadNormalisedAndChecked) {
+  std::string text = kChannel;
+  text.replace(text.find("  walls { half_space { point: [0, 0.2]"), 0,
+               "  mirror_planes { point: [0, 0.1] normal: [0, -3] }\n");
+  const cases::Case c = parse_case_text(text, "channel.textproto");
+  const FluidSetup<2> setup = fluid_setup_from_case<2>(c, "channel.textproto");
+  ASSERT_EQ(setup.settings.mirror_planes.size(), 1u);
+  EXPECT_DOUBLE_EQ(setup.settings.mirror_planes[0].normal[1], -1.0);
+  // The fill keeps only the half below the plane: 100 x 10 fluid particles.
+  FluidSolver<2> solver = make_solver<2>(setup);
+  EXPECT_EQ(solver.particles().count(Kind::fluid), 1000u);
+
+  text.replace(text.find("normal: [0, -3]"), 15, "normal: [0, 0]");
+  try {
+    fluid_setup_from_case<2>(parse_case_text(text, "channel.textproto"), "channel.textproto");
+    FAIL() << "expected a CaseError";
+  } catch (const CaseError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("channel.textproto"), std::string::npos) << what;
+    EXPECT_NE(what.find("mirror_planes[0].normal"), std::string::npos) << what;
+    EXPECT_NE(what.find("zero vector"), std::string::npos) << what;
+  }
+}
+
 }  // namespace
 }  // namespace valvefsi::fluid

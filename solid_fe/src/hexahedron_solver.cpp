@@ -366,10 +366,19 @@ void HexahedronSolver::advance_window(double t_end, const Eigen::Matrix3Xd* noda
 
 void HexahedronSolver::element_fields(Eigen::VectorXd& max_principal_stress,
                                       Eigen::VectorXd& max_principal_log_strain) const {
-  // The largest of the centre (3D law at the F-bar F) and the centres of the faces zeta = -1, +1,
-  // the leaflet's free surfaces: there the full trilinear gradient gives the in-plane C2 in the
-  // material frame, evaluated with the sheet's plane-stress law (sigma33 = 0, as the shell's outer
-  // thickness points), so a one-brick-thick leaflet reports its bending strain and stress.
+  fields(max_principal_stress, max_principal_log_strain, false);
+}
+
+void HexahedronSolver::surface_fields(Eigen::VectorXd& max_principal_stress,
+                                      Eigen::VectorXd& max_principal_log_strain) const {
+  fields(max_principal_stress, max_principal_log_strain, true);
+}
+
+void HexahedronSolver::fields(Eigen::VectorXd& max_principal_stress, Eigen::VectorXd& max_principal_log_strain,
+                              bool surfaces) const {
+  // Centre: the 3D law at the F-bar F (the integration point). Surfaces: the centres of the faces
+  // zeta = -1, +1, where the full trilinear gradient gives the in-plane C2 in the material frame,
+  // evaluated with the sheet's plane-stress law (sigma33 = 0, as the shell's outer thickness points).
   static const std::array<Eigen::Matrix<double, 3, 8>, 2> faces{hex_shape_derivatives(Eigen::Vector3d(0, 0, -1)),
                                                                 hex_shape_derivatives(Eigen::Vector3d(0, 0, 1))};
   const Material sheet = plane_stress_form(material_);
@@ -388,6 +397,12 @@ void HexahedronSolver::element_fields(Eigen::VectorXd& max_principal_stress,
             double stress = eig.eigenvalues().maxCoeff();
             eig.computeDirect(k.F.transpose() * k.F, Eigen::EigenvaluesOnly);
             double strain = 0.5 * std::log(eig.eigenvalues().maxCoeff());
+            if (!surfaces) {
+              max_principal_stress(e) = stress;
+              max_principal_log_strain(e) = strain;
+              continue;
+            }
+            stress = strain = -std::numeric_limits<double>::infinity();
             Eigen::Matrix<double, 3, 8> X;
             for (int a = 0; a < 8; ++a) X.col(a) = model_.reference_positions.col(el.nodes[static_cast<std::size_t>(a)]);
             const Eigen::Matrix<double, 3, 2> in_plane = el.material_axes.leftCols<2>();

@@ -107,9 +107,12 @@ class HexahedronSolver {
   const HexahedronSolverOptions& options() const { return options_; }
   Eigen::Matrix3Xd displacement() const { return state_.position - model_.reference_positions; }
 
-  // Per-element maximum principal Cauchy stress (Pa) and logarithmic strain of the state: the
-  // largest of the centre and the two zeta = -1, +1 face centres (the leaflet surfaces).
+  // Per-element maximum principal Cauchy stress (Pa) and logarithmic strain at the element centre,
+  // the one integration point (what the reference's one-point bricks report).
   void element_fields(Eigen::VectorXd& max_principal_stress, Eigen::VectorXd& max_principal_log_strain) const;
+  // The same on the two faces zeta = -1, +1 (the leaflet's surfaces, bending included), larger of
+  // the two, from the trilinear gradient with the sheet's plane-stress law.
+  void surface_fields(Eigen::VectorXd& max_principal_stress, Eigen::VectorXd& max_principal_log_strain) const;
 
   // For tests: forces the next step to use dt = factor x the critical-step estimate (safety 1).
   void set_step_factor_for_testing(double factor) { step_factor_ = factor; }
@@ -120,6 +123,7 @@ class HexahedronSolver {
   void compute_contact_force();
   void apply_constraints(Eigen::Matrix3Xd& field) const;
   void update_kinetic_energy();
+  void fields(Eigen::VectorXd& max_principal_stress, Eigen::VectorXd& max_principal_log_strain, bool surfaces) const;
 
   HexahedronModel model_;
   SolidMaterial material_;

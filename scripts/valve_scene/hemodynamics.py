@@ -234,10 +234,12 @@ def annulus_area(dimension: int, radius: float = ANNULUS_RADIUS_M) -> float:
 
 def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.PERIOD_S,
                   smoothing_s: float = 0.002, closure_time_s: float | None = None,
-                  hydrostatic_Pa: float | None = None, annulus_radius: float = ANNULUS_RADIUS_M) -> CycleHemodynamics:
+                  hydrostatic_Pa: float | None = None, annulus_radius: float = ANNULUS_RADIUS_M,
+                  symmetry_factor: float = 1.0) -> CycleHemodynamics:
     """Metrics of cycle `cycle` (1-based: [(cycle-1) T, cycle T)). closure_time_s, if given, is
     the valve's closure within the cycle (e.g. from the kinematics) and splits closing from
-    leakage volume."""
+    leakage volume. symmetry_factor multiplies the flows and forces of a symmetric part (6 for
+    the 1/6 sector) into the whole valve's."""
     start, end = (cycle - 1) * period, cycle * period
     t_all = series.time
     sel = (t_all >= start - 1e-12) & (t_all <= end + 1e-12)
@@ -247,7 +249,7 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
     t = t_all[sel]
     if t[-1] < end - 0.05 * period:
         raise ValueError(f"cycle {cycle} is incomplete: the series ends at {t[-1]:g} s, the cycle at {end:g} s")
-    q = series.mean_flow_rate[sel]
+    q = series.mean_flow_rate[sel] * symmetry_factor
     dp = series.pressure_drop[sel]
     q_s = moving_average(t, q, smoothing_s)
     t1, t2 = forward_flow_period(t, q_s)
@@ -263,7 +265,7 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
     closing = -integral(t, q, t2, t_close) * to_volume
     leakage = -integral(t, q, t_close, t[-1]) * to_volume
     peak_q = float(np.max(q)) * to_volume
-    sections = {name: integral(t, rate[sel], t1, t2) * to_volume for name, rate in series.flow_rates.items()}
+    sections = {name: integral(t, rate[sel] * symmetry_factor, t1, t2) * to_volume for name, rate in series.flow_rates.items()}
 
     velocity = velocity_time = None
     if series.max_velocity is not None:
@@ -274,7 +276,7 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
     hydrostatic_force = -p_max * annulus_area(series.dimension, annulus_radius)
     pull_out = diastolic = diastolic_time = ratio = None
     if series.axial_force is not None and series.force_time is not None:
-        tf, f = series.force_time, series.axial_force
+        tf, f = series.force_time, series.axial_force * symmetry_factor
         systole = (tf >= t1) & (tf <= t2)
         diastole = (tf > t2) & (tf <= end + 1e-12)
         if np.any(systole):
@@ -389,11 +391,13 @@ def main(argv=None) -> None:
     parser.add_argument("--cycle", type=int, default=2, help="cycle analysed (1-based; default 2)")
     parser.add_argument("--model", default="this run", help="column name in the table, e.g. FSI-Ogden")
     parser.add_argument("--closure-time", type=float, help="valve closure within the cycle (s), e.g. from the kinematics")
+    parser.add_argument("--symmetry-factor", type=float, default=1.0,
+                        help="flows and forces x this for the whole valve (6 for a 1/6-sector run)")
     parser.add_argument("--markdown", type=Path, help="write the table here")
     parser.add_argument("--png", type=Path, help="write the Fig. 11-like plot here")
     args = parser.parse_args(argv)
     series = read_run(args.run_dir)
-    result = analyse_cycle(series, args.cycle, closure_time_s=args.closure_time)
+    result = analyse_cycle(series, args.cycle, closure_time_s=args.closure_time, symmetry_factor=args.symmetry_factor)
     table = hemodynamics_table({args.model: result})
     print(table)
     print("section stroke volumes:", {k: round(v, 3) for k, v in result.section_stroke_volumes.items()})

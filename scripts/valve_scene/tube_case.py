@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 
 from .tube import TubeSetup
-from .valve_geometry import ValveParameters
+from .valve_geometry import LEAFLET_COUNT, SECTOR_HALF_ANGLE, ValveParameters
 
 PLATE_LAYERS = 3                      # plate thickness in particle spacings
 STROKE_VOLUME_M3 = 60e-6              # generous: the reference's flow implies ~40 mL per beat
@@ -27,17 +27,43 @@ def _vec(values) -> str:
     return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
 
 
+PA_PER_MMHG = 133.322387415
+SECTOR_TAP_RADIUS = 3.0e-3            # sector pressure taps: off the axis, where the two mirror planes meet
+
+
+def aortic_pressure_at_opening_mmHg() -> float:
+    """The waveform's pressures at t = 0 (both 80.73 mmHg: dp = 0 there), to 0.01 mmHg."""
+    import numpy as np
+    from . import waveform
+    return round(float(waveform.aortic_pressure_mmHg()(np.array([0.0]))[0]), 2)
+
+
+def sector_mirror_planes() -> list[tuple[list[float], list[float]]]:
+    """The 1/6 sector's cut faces as fluid mirror planes (point, normal toward the fluid): the
+    leaflet's bisecting plane y = 0 and the coaptation plane at 60 degrees, as in the sector mesh."""
+    a = SECTOR_HALF_ANGLE
+    return [([0.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+            ([0.0, 0.0, 0.0], [math.sin(a), -math.cos(a), 0.0])]
+
+
 def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = None,
-                valve: ValveParameters | None = None, sound_speed: float = 145.0) -> str:
-    """The fluid part of a full-valve FSI case (3D)."""
+                valve: ValveParameters | None = None, sound_speed: float = 145.0,
+                sector: bool = False) -> str:
+    """The fluid part of a full-valve (or, with sector=True, 1/6-sector) FSI case (3D). The
+    sector keeps the full tube's walls, blocks and plates; its two mirror planes leave only the
+    wedge's particles (fluid_sph drops those beyond a mirror plane), the plates' wetted areas
+    are a sixth, and the pressure taps move 3 mm off the axis into the wedge (on the axis,
+    where the planes meet, images of images are missing)."""
     setup = setup or TubeSetup()
     valve = valve or ValveParameters()
     setup.validate()
     dp = particle_spacing
+    offset = aortic_pressure_at_opening_mmHg()
     R_tube = 0.5 * setup.tube_diameter
-    area = math.pi * R_tube ** 2
+    tube_area = math.pi * R_tube ** 2
+    area = tube_area / (2 * LEAFLET_COUNT if sector else 1)   # the plates' wetted area
     plate = PLATE_LAYERS * dp
-    travel = cycles * STROKE_VOLUME_M3 / area
+    travel = cycles * STROKE_VOLUME_M3 / tube_area
     z_inlet = -setup.upstream_length
     z_outlet = setup.downstream_length
     tube_start = z_inlet - plate - 2 * dp
@@ -55,9 +81,16 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
         "  dynamic_viscosity: 0.0035",
         f"  sound_speed: {sound_speed:g}",
         "  density_diffusion: 0.1",
-        f"  domain_lower: {_vec([-R_tube - margin, -R_tube - margin, tube_start - margin])}",
+        f"  # the fluid starts at the aortic pressure at opening ({offset:g} mmHg): background pressure",
+        "  # plus the plates' offset below, so neither plate starts with a step load",
+        f"  background_pressure: {offset * PA_PER_MMHG:.9g}",
+        f"  domain_lower: {_vec([-margin if sector else -R_tube - margin, -margin if sector else -R_tube - margin, tube_start - margin])}",
         f"  domain_upper: {_vec([R_tube + margin, R_tube + margin, tube_end + margin])}",
         f"  lattice_origin: {_vec([0.0, 0.0, z_inlet])}",
+        *([f"  # 1/6 sector: the bisecting plane (on a lattice plane) and the coaptation plane as mirrors"] +
+          [f"  mirror_planes {{ point: {_vec(point)} normal: [{', '.join(f'{v:.15g}' for v in normal)}] }}"
+           for point, normal in sector_mirror_planes()]
+          if sector else []),
         "  # blood between the plates; the walls take precedence",
         f"  fluid_blocks {{ box {{ lower: {_vec([-R_tube, -R_tube, z_inlet])} upper: {_vec([R_tube, R_tube, z_outlet])} }} }}",
         f"  # ISO 5840-3 tube, {setup.tube_diameter * 1e3:.1f} mm, extended past the outlet plate by its travel",
@@ -68,17 +101,19 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
         "  # inlet plate: left-ventricular pressure",
         "  plates {",
         f"    shape {{ annular_disk {{ origin: {_vec([0, 0, z_inlet - plate])} axis: [0, 0, 1] thickness: {plate:.6g} outer_radius: {R_tube:.6g} }} }}",
-        f"    normal: [0, 0, 1] area: {area:.6g} pressure_source: VENTRICULAR",
+        f"    normal: [0, 0, 1] area: {area:.6g} pressure_source: VENTRICULAR pressure_mmHg: {-offset:g}",
         "  }",
         "  # outlet plate: aortic pressure",
         "  plates {",
         f"    shape {{ annular_disk {{ origin: {_vec([0, 0, z_outlet])} axis: [0, 0, 1] thickness: {plate:.6g} outer_radius: {R_tube:.6g} }} }}",
-        f"    normal: [0, 0, -1] area: {area:.6g} pressure_source: AORTIC",
+        f"    normal: [0, 0, -1] area: {area:.6g} pressure_source: AORTIC pressure_mmHg: {-offset:g}",
         "  }",
         "  probes {",
     ]
+    tap_xy = ([SECTOR_TAP_RADIUS * math.cos(0.5 * SECTOR_HALF_ANGLE), SECTOR_TAP_RADIUS * math.sin(0.5 * SECTOR_HALF_ANGLE)]
+              if sector else [0.0, 0.0])
     for name in ("upstream_tap", "downstream_tap"):
-        lines.append(f"    pressure_points {{ name: \"{name}\" position: {_vec([0, 0, probes_z[name]])} }}")
+        lines.append(f"    pressure_points {{ name: \"{name}\" position: {_vec(tap_xy + [probes_z[name]])} }}")
     for name, z in probes_z.items():
         lines.append(f"    flow_planes {{ name: \"{name}\" point: {_vec([0, 0, z])} normal: [0, 0, 1] }}")
     lines.append(f"    velocity_planes {{ name: \"15mm_downstream\" point: {_vec([0, 0, VELOCITY_PROBE_DOWNSTREAM])} normal: [0, 0, 1] }}")

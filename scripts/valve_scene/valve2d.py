@@ -27,6 +27,7 @@ import numpy as np
 from . import waveform
 from .mesh_io import write_mesh
 from .tube import TubeSetup
+from .tube_case import aortic_pressure_at_opening_mmHg
 from .valve_geometry import ValveParameters
 from .valve_mesh import ValveMesh, leaflet_grid
 
@@ -203,8 +204,6 @@ def coupling_window(sound_speed: float, valve: ValveParameters | None = None) ->
     return math.floor(window / 0.5e-6) * 0.5e-6
 
 
-def aortic_pressure_at_opening_mmHg() -> float:
-    return round(float(waveform.aortic_pressure_mmHg()(np.array([0.0]))[0]), 2)
 
 
 def _vec(values) -> str:

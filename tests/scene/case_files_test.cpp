@@ -1,6 +1,7 @@
 // The TAV case files written by scripts/valve_scene/write_cases.py load with the project's case
 // loader, and their waveform tables give the reference's pressures through the project's
 // waveform evaluator (docs/valve-scene.md).
+#include <cmath>
 #include <filesystem>
 #include <regex>
 #include <string>
@@ -26,9 +27,9 @@ std::vector<fs::path> scene_cases() {
 
 double mmHg(double pascal) { return pascal / valvefsi::kPascalPerMmHg; }
 
-TEST(SceneCaseFiles, AllEighteenArePresent) {
-  // FE: 2 materials x 2 variants x 3 resolutions; FSI: 2 materials x full x 3 resolutions
-  EXPECT_EQ(scene_cases().size(), 18U);
+TEST(SceneCaseFiles, AllTwentyFourArePresent) {
+  // FE and FSI: 2 materials x 2 variants (full, sector) x 3 resolutions
+  EXPECT_EQ(scene_cases().size(), 24U);
 }
 
 TEST(SceneCaseFiles, LoadAndMatchTheirNames) {
@@ -56,6 +57,11 @@ TEST(SceneCaseFiles, LoadAndMatchTheirNames) {
       EXPECT_DOUBLE_EQ(c.fluid().density(), 1056.0);
       EXPECT_DOUBLE_EQ(c.fluid().sound_speed(), 145.0);
       EXPECT_EQ(c.fluid().plates_size(), 2);
+      // no step load at t = 0: the plates' offset cancels the background pressure
+      EXPECT_NEAR(c.fluid().plates(0).pressure_mmhg() * valvefsi::kPascalPerMmHg + c.fluid().background_pressure(), 0.0, 1e-3);
+      // a sector's wedge between two mirror planes, its plates a sixth of the tube
+      EXPECT_EQ(c.fluid().mirror_planes_size(), m[3] == "sector" ? 2 : 0);
+      EXPECT_NEAR(c.fluid().plates(0).area(), M_PI * 0.0184 * 0.0184 / (m[3] == "sector" ? 6.0 : 1.0), 1e-8);
     }
   }
 }

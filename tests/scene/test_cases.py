@@ -32,6 +32,22 @@ class CaseFiles(unittest.TestCase):
         for spec in all_specs():
             self.assertIn(f'mesh_file: "meshes/valve-{spec.variant}-{spec.resolution}.mesh.h5"', case_text(spec))
 
+    def test_sector_fsi_mirrors_are_the_sector_meshs_planes(self):
+        import re
+        mesh = build_valve_mesh("sector", "coarse", "triangles")
+        expected = [mesh.symmetry_planes["leaflet_bisector"][1], mesh.contact_planes["coaptation"][1]]
+        for spec in all_specs():
+            if spec.kind != "FSI":
+                continue
+            normals = [np.array([float(v) for v in m.split(",")]) for m in
+                       re.findall(r"mirror_planes \{ point: \[0, 0, 0\] normal: \[([^\]]*)\]", case_text(spec))]
+            if spec.variant == "full":
+                self.assertEqual(normals, [])
+                continue
+            self.assertEqual(len(normals), 2)
+            for got, want in zip(normals, expected):
+                np.testing.assert_allclose(got, want, atol=1e-14)
+
     def test_every_3d_case_has_the_stent_cylinder(self):
         for spec in all_specs():
             self.assertIn(f"contact_cylinders {{ origin: [0, 0, 0] axis: [0, 0, 1] radius: {stent_radius():.6g} }}", case_text(spec))

@@ -150,6 +150,18 @@ class Cycles(unittest.TestCase):
         self.assertAlmostEqual(r.q_rms, math.sqrt(0.5 * QMAX ** 2 + 0.5 * (0.05 * QMAX) ** 2) * 1e6, delta=0.01 * QMAX * 1e6)
 
 
+class Sector(unittest.TestCase):
+    def test_a_sixth_of_the_valve_times_six_is_the_valve(self):
+        full = synthetic()
+        sector = synthetic()
+        sector.flow_rates = {k: v / 6 for k, v in sector.flow_rates.items()}
+        sector.axial_force = sector.axial_force / 6
+        a = hd.analyse_cycle(full, smoothing_s=0.0)
+        b = hd.analyse_cycle(sector, smoothing_s=0.0, symmetry_factor=6)
+        for name in ("q_rms", "eoa", "regurgitant_volume", "pull_out_force", "diastolic_force", "water_hammer_ratio", "mspd_mmHg"):
+            self.assertAlmostEqual(getattr(a, name), getattr(b, name), delta=1e-9 * max(1, abs(getattr(a, name))), msg=name)
+
+
 class TwoDimensional(unittest.TestCase):
     def test_per_depth_units(self):
         r3 = hd.analyse_cycle(synthetic(dimension=3), smoothing_s=0.0)

@@ -315,8 +315,8 @@ def header_2d(spec: Case2D) -> str:
         shows = ("a solver check, not a valve result: the leaflets open in ~25 ms and lie on the stent "
                  "faces through ejection, swing shut when the gradient reverses (~0.245 s), then slip past "
                  "each other and prolapse upstream onto the stent faces (measured, solid_fe 2026-11-22): a "
-                 "2D leaflet has no circumferential support and, without a stop on the axis for each "
-                 "leaflet, no closed equilibrium (docs/valve-scene.md)")
+                 "2D leaflet has no circumferential support, and with frictionless contact a 2D leaflet "
+                 "pair does not close against the reverse gradient (docs/valve-scene.md)")
         run = f"/usr/bin/python3 scripts/run_case.py cases/{spec.name}.textproto --output runs/{spec.name} --fe-only"
     else:
         dp = PARTICLE_SPACING_2D[spec.resolution]

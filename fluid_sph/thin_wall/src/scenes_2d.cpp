@@ -1,5 +1,6 @@
 #include "valvefsi/fluid/thin_wall/scenes_2d.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -52,6 +53,46 @@ ThinWallCase2D oscillating_plate_box(double dp, const OscillatingPlate& plate) {
     w.position = {{x, -half}, {x, half}};
     w.velocity = {{v, 0.0}, {v, 0.0}};
     w.acceleration = {{a, 0.0}, {a, 0.0}};
+  };
+  return c;
+}
+
+double ClosingFlaps::half_gap(double t) const {
+  const double s = std::clamp(t / duration, 0.0, 1.0);
+  return end_half_gap + (start_half_gap - end_half_gap) * (1.0 - s * s * (3.0 - 2.0 * s));
+}
+
+double ClosingFlaps::closing_speed(double t) const {
+  const double s = std::clamp(t / duration, 0.0, 1.0);
+  return (start_half_gap - end_half_gap) * 6.0 * s * (1.0 - s) / duration;
+}
+
+ThinWallCase2D closing_flaps_box(double dp, const ClosingFlaps& flaps) {
+  ThinWallCase2D c;
+  auto& s = c.fluid;
+  s.particle_spacing = dp;
+  s.rest_density = 1000.0;
+  s.dynamic_viscosity = 1e-3;
+  // The squeezed water leaves the gap at about V b / (2 d); c0 keeps it below 0.1 c0 down to
+  // d = dp, where the last particles leave.
+  const double top_speed = 1.5 * (flaps.start_half_gap - flaps.end_half_gap) / flaps.duration;
+  s.sound_speed = std::max(20.0, 10.0 * top_speed * flaps.flap_length / (2.0 * dp));
+  s.shifting = 1.0;
+  const double L = flaps.box;
+  s.domain_lower = {-0.7 * L, -0.7 * L};
+  s.domain_upper = {0.7 * L, 0.7 * L};
+  c.scene.walls.push_back(container_box<2>({-L / 2, -L / 2}, {L / 2, L / 2}));
+  c.scene.fluid.push_back({{-L / 2, -L / 2}, {L / 2, L / 2}, {}, [](const Vec<2>&) { return 0.0; }});
+  const double half = flaps.flap_length / 2;
+  // Left flap runs upwards, right flap downwards: side +1 of both faces away from the gap.
+  c.walls.push_back(Polyline::at_rest({{-flaps.start_half_gap, -half}, {-flaps.start_half_gap, half}}));
+  c.walls.push_back(Polyline::at_rest({{flaps.start_half_gap, half}, {flaps.start_half_gap, -half}}));
+  c.motion = [flaps, half](double t, std::vector<Polyline>& walls) {
+    const double d = flaps.half_gap(t), v = flaps.closing_speed(t);
+    walls[0].position = {{-d, -half}, {-d, half}};
+    walls[0].velocity = {{v, 0.0}, {v, 0.0}};
+    walls[1].position = {{d, half}, {d, -half}};
+    walls[1].velocity = {{-v, 0.0}, {-v, 0.0}};
   };
   return c;
 }

@@ -39,4 +39,19 @@ struct OscillatingPlate {
 };
 ThinWallCase2D oscillating_plate_box(double dp, const OscillatingPlate& plate);
 
+// Coaptation: two parallel flaps of length b (along y, centred on y = 0) at x = -d(t) and
+// x = +d(t) in a closed box [-L/2, L/2]^2 full of water (no gravity) close onto each other:
+// d goes from d0 to d_min along a smooth step over `duration` (zero speed at both ends), so
+// the water between them must leave along the gap, through its two open ends.
+struct ClosingFlaps {
+  double flap_length = 0.1;  // b (m)
+  double start_half_gap = 0.03;  // d0 (m)
+  double end_half_gap = 0.002;   // d_min (m)
+  double duration = 0.5;     // s
+  double box = 0.3;          // L (m)
+  double half_gap(double t) const;
+  double closing_speed(double t) const;  // -dd/dt (m/s)
+};
+ThinWallCase2D closing_flaps_box(double dp, const ClosingFlaps& flaps);
+
 }  // namespace valvefsi::fluid::thin_wall

@@ -112,8 +112,9 @@ class CycleHemodynamics:
 
 
 def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "downstream_tap",
-             velocity_plane: str | None = None) -> ProbeSeries:
-    """Reads RUN_DIR/fluid_probes.h5 and, if present, RUN_DIR/coupling_series.h5."""
+             velocity_plane: str | None = None, sections: list[str] | None = None) -> ProbeSeries:
+    """Reads RUN_DIR/fluid_probes.h5 and, if present, RUN_DIR/coupling_series.h5. `sections`
+    chooses the flow sections averaged (default: all)."""
     import h5py
     run_dir = Path(run_dir)
     path = run_dir / "fluid_probes.h5"
@@ -126,7 +127,11 @@ def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "d
         for name in (upstream, downstream):
             if name not in f["pressure"]:
                 raise ValueError(f"{path}: no dataset '/pressure/{name}': have {', '.join(f['pressure'])}")
-        flows = {name: f["flow_rate"][name][()].reshape(-1) for name in f["flow_rate"]}
+        names = sections or list(f["flow_rate"])
+        missing = [name for name in names if name not in f["flow_rate"]]
+        if missing:
+            raise ValueError(f"{path}: no dataset '/flow_rate/{missing[0]}': have {', '.join(f['flow_rate'])}")
+        flows = {name: f["flow_rate"][name][()].reshape(-1) for name in names}
         if not flows:
             raise ValueError(f"{path}: '/flow_rate' holds no section")
         velocity = None
@@ -391,12 +396,13 @@ def main(argv=None) -> None:
     parser.add_argument("--cycle", type=int, default=2, help="cycle analysed (1-based; default 2)")
     parser.add_argument("--model", default="this run", help="column name in the table, e.g. FSI-Ogden")
     parser.add_argument("--closure-time", type=float, help="valve closure within the cycle (s), e.g. from the kinematics")
+    parser.add_argument("--sections", nargs="+", help="flow sections to average (default: all in the file)")
     parser.add_argument("--symmetry-factor", type=float, default=1.0,
                         help="flows and forces x this for the whole valve (6 for a 1/6-sector run)")
     parser.add_argument("--markdown", type=Path, help="write the table here")
     parser.add_argument("--png", type=Path, help="write the Fig. 11-like plot here")
     args = parser.parse_args(argv)
-    series = read_run(args.run_dir)
+    series = read_run(args.run_dir, sections=args.sections)
     result = analyse_cycle(series, args.cycle, closure_time_s=args.closure_time, symmetry_factor=args.symmetry_factor)
     table = hemodynamics_table({args.model: result})
     print(table)

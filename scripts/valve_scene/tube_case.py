@@ -70,9 +70,10 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
     tube_end = z_outlet + plate + travel + 2 * dp
     ring_start = setup.gasket_z - setup.gasket_thickness
     margin = 6 * dp
-    probes_z = {"inlet_side": z_inlet + 10e-3, "upstream_tap": -setup.upstream_tap_distance,
+    # flow sections stay ahead of the inlet plate over all cycles (it travels ~5 cm per cycle)
+    probes_z = {"upstream_tap": -setup.upstream_tap_distance,
                 "leaflet_base": 0.0, "commissure_tops": valve.commissure_height,
-                "downstream_tap": setup.downstream_tap_distance}
+                "downstream_30mm": 30e-3, "downstream_tap": setup.downstream_tap_distance}
     lines = [
         "fluid {",
         f"  particle_spacing: {dp:g}",

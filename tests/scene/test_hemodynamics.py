@@ -207,6 +207,16 @@ class Files(unittest.TestCase):
             self.assertAlmostEqual(a.eoa, b.eoa, delta=1e-12)
             self.assertAlmostEqual(a.diastolic_force, b.diastolic_force, delta=1e-12)
 
+    def test_chosen_sections_are_averaged(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            self.write_run(Path(tmp), synthetic())
+            only_a = hd.read_run(Path(tmp), sections=["a"])
+            self.assertEqual(list(only_a.flow_rates), ["a"])
+            r = hd.analyse_cycle(only_a, smoothing_s=0.0)
+            self.assertAlmostEqual(r.q_rms, 1.1 * QMAX / math.sqrt(2) * 1e6, delta=1e-6 * QMAX * 1e6)
+            with self.assertRaisesRegex(ValueError, "no dataset '/flow_rate/c': have a, b"):
+                hd.read_run(Path(tmp), sections=["a", "c"])
+
     def test_missing_tap_is_named(self):
         with tempfile.TemporaryDirectory() as tmp:
             self.write_run(Path(tmp), synthetic())

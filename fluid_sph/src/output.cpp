@@ -46,21 +46,26 @@ SnapshotWriter<D>::SnapshotWriter(const std::filesystem::path& directory) : dire
 template <int D>
 void SnapshotWriter<D>::write(const FluidSolver<D>& solver) {
   const auto& p = solver.particles();
-  const std::size_t n = p.size();
+  // Mirror images are scratch of the symmetry planes, rebuilt every step: not written.
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) n += !is_mirror(p.kind[i]);
   std::vector<double> position(3 * n, 0.0), velocity(3 * n, 0.0);
   std::vector<float> pressure(n), density(n);
   std::vector<int> kind(n);
   std::vector<unsigned> id(n);
   const double background = solver.settings().background_pressure;
-  for (std::size_t i = 0; i < n; ++i) {
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (is_mirror(p.kind[i])) continue;
     for (int d = 0; d < D; ++d) {
-      position[3 * i + d] = p.position[d][i];
-      velocity[3 * i + d] = p.velocity[d][i];
+      position[3 * j + d] = p.position[d][i];
+      velocity[3 * j + d] = p.velocity[d][i];
     }
-    pressure[i] = static_cast<float>(p.pressure[i] - background);
-    density[i] = static_cast<float>(solver.settings().rest_density + p.density_excess[i]);
-    kind[i] = static_cast<int>(p.kind[i]);
-    id[i] = p.id[i];
+    pressure[j] = static_cast<float>(p.pressure[i] - background);
+    density[j] = static_cast<float>(solver.settings().rest_density + p.density_excess[i]);
+    kind[j] = static_cast<int>(p.kind[i]);
+    id[j] = p.id[i];
+    ++j;
   }
   const auto file = directory_ / "fluid_particles.h5";
   const hid_t h = check_id(H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), "open " + file.string());

@@ -5,13 +5,19 @@
 //     holds the hydrostatic pressure rho g (H - y), as well next to the plane as far from it,
 //     and no particle ends a step beyond the plane.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <numbers>
 
 #include "valvefsi/fluid/fluid_solver.hpp"
 #include "valvefsi/fluid/geometry.hpp"
+#include "valvefsi/fluid/output.hpp"
 #include "valvefsi/fluid/probes.hpp"
+
+#include <hdf5.h>
+
+#include <filesystem>
 
 namespace valvefsi::fluid {
 namespace {
@@ -76,6 +82,26 @@ TEST(MirrorPlanes, HalfChannelWithMirrorMatchesFullChannel) {
   EXPECT_GT(peak, 0.5 * F * L * L / (8 * nu));  // the flow has started: > half the steady centreline speed
   EXPECT_LT(worst, 1e-3 * peak);
   EXPECT_EQ(half.lost_count(), 0u);
+
+  // Snapshots hold the particles, not their images.
+  const auto dir = std::filesystem::temp_directory_path() / ("fluid_mirror_snapshot_" + std::to_string(::getpid()));
+  {
+    SnapshotWriter<2> writer(dir);
+    writer.write(half);
+  }
+  const hid_t file = H5Fopen((dir / "fluid_particles.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  const hid_t data = H5Dopen2(file, "snapshot_000000/kind", H5P_DEFAULT);
+  const hid_t space = H5Dget_space(data);
+  hsize_t rows[2] = {0, 0};
+  H5Sget_simple_extent_dims(space, rows, nullptr);
+  H5Sclose(space);
+  H5Dclose(data);
+  H5Fclose(file);
+  std::filesystem::remove_all(dir);
+  const auto& p = half.particles();
+  EXPECT_EQ(rows[0], p.count(Kind::fluid) + p.count(Kind::wall));
+  EXPECT_LT(rows[0], p.size());
 }
 
 TEST(MirrorPlanes, TiltedMirrorHoldsHydrostaticColumn) {

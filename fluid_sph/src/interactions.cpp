@@ -208,7 +208,12 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
         const float p_b = p.pressure[b], inv_b = p.inverse_density[b], ex_b = p.excess[b], is_fluid = p.fluid[b];
         if constexpr (Masked) {
           if (block_near || filter.is_near(b)) {
-            for (int i = 0; i < n; ++i) keep[i] = filter.blocked(block + static_cast<std::uint32_t>(i), b) ? 0.0f : 1.0f;
+            // Pairs beyond the support have no weight anyway: ask only about the others.
+            for (int i = 0; i < n; ++i) {
+              const float dx = xa[0][i] - xb, dy = xa[1][i] - yb, dz = D == 3 ? xa[2][i] - zb : 0.0f;
+              const bool inside = dx * dx + dy * dy + dz * dz < k.support2;
+              keep[i] = inside && filter.blocked(block + static_cast<std::uint32_t>(i), b) ? 0.0f : 1.0f;
+            }
             keep_dirty = true;
           } else if (keep_dirty) {
             for (int i = 0; i < n; ++i) keep[i] = 1.0f;

@@ -1,6 +1,7 @@
 // 2D proofs (a) and (b) of the thin wall (docs/thin-leaflet.md):
 // (a) a thin wall buried in the floor between water levels 1.0 m and 0.5 m holds both levels
-//     with no leak, and the fluid's net force on it is rho g (h1^2 - h2^2) / 2;
+//     with no leak, and the fluid's net force on it is rho g (h1^2 - h2^2) / 2; the same with
+//     the wall's end flush on the floor (attachment line);
 // (b) the same wall standing 0.1 m above the floor: water flows under its free end, the run
 //     stays stable for 3 s, the levels equalise towards (h1 + h2) / 2, no leak.
 #include <gtest/gtest.h>
@@ -50,10 +51,13 @@ Levels surface(const ThinWallSolverRun2D& flow) {
 }
 
 // The scenes hold ~2000 particles: one thread, since threading overhead exceeds the work.
-TEST(ThinWallTwoLevels, ClosedWallHoldsLevelsAndCarriesTheHydrostaticLoad) {
+// The closed wall with its lower (attached) end at height `bottom` (< 0: buried in the floor).
+void closed_wall(double bottom, const char* name) {
   omp_set_num_threads(1);
   const double dp = 0.025, h1 = 1.0, h2 = 0.5, rho = 1000.0, g = 9.81;
-  ThinWallSolverRun2D flow(two_level_tank(dp, h1, h2, 0.0));
+  ThinWallCase2D c = two_level_tank(dp, h1, h2, 0.0);
+  c.walls.front().position.front()[1] = bottom;
+  ThinWallSolverRun2D flow(std::move(c));
   const Levels start = levels(flow);
   flow.advance_to(0.5);
   double fx = 0, fy = 0;
@@ -69,9 +73,9 @@ TEST(ThinWallTwoLevels, ClosedWallHoldsLevelsAndCarriesTheHydrostaticLoad) {
   const double expected = rho * g * (h1 * h1 - h2 * h2) / 2;
   const Levels end = levels(flow);
   const Levels top = surface(flow);
-  std::printf("closed wall: force %.1f N/m (analytic %.1f, %+.2f %%), vertical %.2f N/m; surface %.4f / %.4f m; "
+  std::printf("closed wall, %s: force %.1f N/m (analytic %.1f, %+.2f %%), vertical %.2f N/m; surface %.4f / %.4f m; "
               "corrections %zu leaks %zu\n",
-              fx, expected, 100 * (fx / expected - 1), fy, top.left, top.right, flow.wall_model().counters().corrections,
+              name, fx, expected, 100 * (fx / expected - 1), fy, top.left, top.right, flow.wall_model().counters().corrections,
               flow.wall_model().counters().leaks);
   EXPECT_NEAR(fx, expected, 0.02 * expected);
   EXPECT_EQ(end.left_count, start.left_count);
@@ -81,6 +85,12 @@ TEST(ThinWallTwoLevels, ClosedWallHoldsLevelsAndCarriesTheHydrostaticLoad) {
   EXPECT_EQ(flow.wall_model().counters().leaks, 0u);
   EXPECT_EQ(flow.lost_count(), 0u);
 }
+
+TEST(ThinWallTwoLevels, ClosedWallHoldsLevelsAndCarriesTheHydrostaticLoad) { closed_wall(-0.075, "buried 3 dp"); }
+
+// The attachment line: the leaflet's end exactly on the rigid floor (the solid's attached end
+// on the stent wall), no burial: the corner must not let water under the wall.
+TEST(ThinWallTwoLevels, WallAttachedFlushOnTheFloorHoldsLevels) { closed_wall(0.0, "attached flush on the floor"); }
 
 TEST(ThinWallTwoLevels, GapUnderTheFreeEndEqualisesLevelsStablyWithoutLeaks) {
   omp_set_num_threads(1);

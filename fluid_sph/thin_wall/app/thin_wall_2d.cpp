@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -39,6 +40,8 @@ int main(int argc, char** argv) {
   app.add_flag("--fluid-velocity-beyond-edge", fluid_velocity_beyond_edge, "virtual points beyond a free end move with the fluid");
   app.add_flag("--round-edge", round_edge, "virtual points reachable round a free end within R carry the other side's state");
   app.add_flag("--round-edge-velocity", round_edge_velocity, "virtual points reachable round a free end within R move with the fluid");
+  double attached_end_y = std::numeric_limits<double>::quiet_NaN();
+  app.add_option("--attached-end-y", attached_end_y, "two_levels: y of the wall's lower end (0: flush with the floor; default buried 3 dp)");
   app.add_option("--window", window, "motion window (s): the wall's targets are set at window ends, as the coupler does");
   app.add_option("--plate-width", plate.plate_width, "plate width b (m)");
   app.add_option("--amplitude", plate.amplitude, "plate amplitude A (m)");
@@ -59,6 +62,7 @@ int main(int argc, char** argv) {
 
   ThinWallCase2D c = scene == "plate" ? oscillating_plate_box(dp, plate)
                                        : two_level_tank(dp, 1.0, 0.5, scene == "gap" ? gap : 0.0);
+  if (!std::isnan(attached_end_y)) c.walls.front().position.front()[1] = attached_end_y;
   c.fluid.shifting = shifting;
   c.fluid.background_pressure = background;
   c.fluid.smoothing_length_ratio = h_ratio;

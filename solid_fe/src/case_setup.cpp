@@ -123,6 +123,8 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   SolverOptions solver_options;
   solver_options.time_step_safety = solid.time_step_safety();
   solver_options.time_step_update_interval = solid.time_step_update_interval();
+  solver_options.time_step_calibration_interval = solid.time_step_calibration_interval();
+  solver_options.max_step_calibration = solid.max_time_step_calibration();
   solver_options.mass_damping_per_s = solid.mass_damping_per_s();
   solver_options.max_time_step = solid.max_time_step();
   solver_options.contact_stiffness_factor = solid.contact_stiffness_factor();

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 #include <omp.h>
 
@@ -174,7 +175,8 @@ void ShellSolver::apply_constraints(Eigen::Matrix3Xd& field) const {
   }
 }
 
-void ShellSolver::compute_internal_force(bool estimate_step) {
+double ShellSolver::evaluate_internal_force(const Eigen::Matrix3Xd& x, bool estimate_step, Eigen::Matrix3Xd& out,
+                                            double& min_step, std::int64_t& critical) {
   const int threads = omp_get_max_threads();
   const Eigen::Index n = model_.reference_positions.cols();
   if (static_cast<int>(thread_forces_.size()) != threads) {
@@ -182,10 +184,9 @@ void ShellSolver::compute_internal_force(bool estimate_step) {
   }
   const auto num_elements = static_cast<std::int64_t>(model_.elements.size());
   double strain_energy = 0.0;
-  double min_step = std::numeric_limits<double>::infinity();
-  std::int64_t critical = -1;
+  min_step = std::numeric_limits<double>::infinity();
+  critical = -1;
   std::string error;
-  const Eigen::Matrix3Xd& x = state_.position;
   std::visit(
       [&](const auto& law) {
         // Small models run serially: thread start-up would cost more than it saves.
@@ -225,14 +226,136 @@ void ShellSolver::compute_internal_force(bool estimate_step) {
   if (!error.empty()) {
     throw MaterialStateError(fmt::format("solid at t = {:.6g} s, step {}: {}", state_.time, state_.step, error));
   }
-  state_.internal_force = thread_forces_[0];
-  for (std::size_t t = 1; t < thread_forces_.size(); ++t) state_.internal_force += thread_forces_[t];
-  state_.energy.strain_energy = strain_energy;
-  if (estimate_step) {
-    state_.stable_step = std::min(options_.time_step_safety * min_step, options_.max_time_step);
+  if (out.cols() != n) out.resize(3, n);
+  out = thread_forces_[0];
+  for (std::size_t t = 1; t < thread_forces_.size(); ++t) out += thread_forces_[t];
+  return strain_energy;
+}
+
+void ShellSolver::compute_internal_force(bool estimate_step) {
+  double min_step = 0;
+  std::int64_t critical = -1;
+  state_.energy.strain_energy =
+      evaluate_internal_force(state_.position, estimate_step, state_.internal_force, min_step, critical);
+  if (options_.fixed_time_step > 0.0) {
+    state_.stable_step = options_.fixed_time_step;
+  } else if (estimate_step) {
+    // Element estimate (always below the true critical step), or, when calibrating, the
+    // model's own critical step 2/omega_max from the last Lanczos run, scaled down (never up)
+    // by how much the element estimate fell since then, so stiffening between calibrations
+    // is followed; a fall below 70 % triggers a new calibration.
+    double critical_step = min_step;
+    const int interval = options_.time_step_calibration_interval;
+    if (interval > 0) {
+      const bool due = state_.calibrated_at_step < 0 || state_.step - state_.calibrated_at_step >= interval ||
+                       min_step < 0.7 * state_.element_step_at_calibration;
+      if (due) calibrate_stable_step(min_step);
+      if (state_.calibrated_step > 0.0) {
+        critical_step = std::clamp(
+            state_.calibrated_step * std::min(1.0, min_step / state_.element_step_at_calibration), min_step,
+            options_.max_step_calibration * min_step);
+      }
+      state_.step_calibration = critical_step / min_step;
+    }
+    state_.stable_step = std::min(options_.time_step_safety * critical_step, options_.max_time_step);
     state_.critical_element = critical;
   }
   internal_force_current_ = true;
+}
+
+void ShellSolver::calibrate_stable_step(double element_step) {
+  // Lanczos on M^-1 K in the mass inner product (symmetric there), K q by a forward difference
+  // of the internal force, full re-orthogonalisation (few vectors). The largest Ritz value plus
+  // its residual bound beta_k |s_k| estimates omega_max^2 from slightly above; a plain power
+  // iteration converges too slowly on the valve's clustered top spectrum (several slivers).
+  const Eigen::Index n = model_.reference_positions.cols();
+  // Deterministic pseudo-random vectors (xorshift seeded by the step), so a restored state
+  // repeats exactly the same calibration.
+  const auto random_matrix = [n](std::uint64_t seed) {
+    Eigen::Matrix3Xd r(3, n);
+    seed = seed * 0x9e3779b97f4a7c15ULL + 0x2545f4914f6cdd1dULL;
+    for (Eigen::Index i = 0; i < r.size(); ++i) {
+      seed ^= seed << 13;
+      seed ^= seed >> 7;
+      seed ^= seed << 17;
+      r.data()[i] = static_cast<double>(seed % 2001) / 1000.0 - 1.0;
+    }
+    return r;
+  };
+  Eigen::Matrix3Xd& v = state_.power_vector;
+  if (v.cols() != n) v = random_matrix(0);
+  const Eigen::ArrayXd mass = model_.nodal_mass.array();
+  const auto m_dot = [&](const Eigen::Matrix3Xd& p, const Eigen::Matrix3Xd& q) {
+    return ((p.cwiseProduct(q)).colwise().sum().transpose().array() * mass).sum();
+  };
+  const double size = (model_.reference_positions.rowwise().maxCoeff() -
+                       model_.reference_positions.rowwise().minCoeff()).norm();
+  const int k_max = std::max(2, options_.power_iterations);
+  lanczos_basis_.resize(static_cast<std::size_t>(k_max + 1));
+  std::vector<double> alpha, beta;
+  // A cold random start each time: a warm start from the last Ritz vector converged to that
+  // mode and missed a sliver that had become the stiffest (measured on the valve sector).
+  Eigen::Matrix3Xd& q0 = lanczos_basis_[0];
+  q0 = random_matrix(static_cast<std::uint64_t>(state_.step) + 1);
+  apply_constraints(q0);
+  double norm = std::sqrt(m_dot(q0, q0));
+  if (!(norm > 0.0)) return;
+  q0 /= norm;
+  double unused_step = 0;
+  std::int64_t unused_element = -1;
+  double theta = 0.0, bound = 0.0;
+  Eigen::VectorXd ritz_vector;
+  int k = 0;
+  for (; k < k_max; ++k) {
+    const Eigen::Matrix3Xd& q = lanczos_basis_[static_cast<std::size_t>(k)];
+    const double h = 1e-7 * size / std::max(q.cwiseAbs().maxCoeff(), 1e-300);
+    probe_position_ = state_.position + h * q;
+    evaluate_internal_force(probe_position_, false, probe_force_, unused_step, unused_element);
+    probe_vector_ = ((probe_force_ - state_.internal_force) / h).array().rowwise() / mass.transpose();  // M^-1 K q
+    apply_constraints(probe_vector_);
+    alpha.push_back(m_dot(q, probe_vector_));
+    for (int j = 0; j <= k; ++j) {  // full re-orthogonalisation (twice is enough)
+      const Eigen::Matrix3Xd& qj = lanczos_basis_[static_cast<std::size_t>(j)];
+      probe_vector_ -= m_dot(qj, probe_vector_) * qj;
+    }
+    for (int j = 0; j <= k; ++j) {
+      const Eigen::Matrix3Xd& qj = lanczos_basis_[static_cast<std::size_t>(j)];
+      probe_vector_ -= m_dot(qj, probe_vector_) * qj;
+    }
+    const double b = std::sqrt(std::max(m_dot(probe_vector_, probe_vector_), 0.0));
+    // Ritz values of the tridiagonal T_k.
+    const auto size_k = static_cast<Eigen::Index>(alpha.size());
+    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(size_k, size_k);
+    for (Eigen::Index i = 0; i < size_k; ++i) {
+      T(i, i) = alpha[static_cast<std::size_t>(i)];
+      if (i + 1 < size_k) T(i, i + 1) = T(i + 1, i) = beta[static_cast<std::size_t>(i)];
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(T);
+    theta = eig.eigenvalues()(size_k - 1);
+    ritz_vector = eig.eigenvectors().col(size_k - 1);
+    bound = b * std::abs(ritz_vector(size_k - 1));
+    if (k >= 10 && bound <= 1e-4 * theta) {
+      ++k;
+      break;
+    }
+    if (!(b > 1e-10 * std::sqrt(std::abs(theta)))) {  // invariant subspace found
+      ++k;
+      break;
+    }
+    beta.push_back(b);
+    lanczos_basis_[static_cast<std::size_t>(k + 1)] = probe_vector_ / b;
+  }
+  // Keep the Ritz vector for the next warm start.
+  v.setZero();
+  for (Eigen::Index i = 0; i < ritz_vector.size(); ++i) v += ritz_vector(i) * lanczos_basis_[static_cast<std::size_t>(i)];
+  state_.calibrated_at_step = state_.step;
+  state_.calibration_iterations = k;
+  state_.element_step_at_calibration = element_step;
+  const double lambda = theta + bound;
+  if (lambda > 0.0) {
+    state_.highest_frequency = std::sqrt(lambda);
+    state_.calibrated_step = 2.0 / state_.highest_frequency;
+  }
 }
 
 void ShellSolver::compute_external_force(double t, const Eigen::Matrix3Xd* nodal_forces) {
@@ -314,7 +437,8 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
       v_half += averaged_step * a;
     }
     apply_constraints(v_half);
-    const Eigen::Matrix3Xd dx = dt * v_half;
+    Eigen::Matrix3Xd& dx = step_increment_;  // no allocation per step
+    dx.noalias() = dt * v_half;
     if (alpha > 0.0) {
       for (Eigen::Index i = 0; i < x.cols(); ++i) {
         state_.energy.damping_work +=

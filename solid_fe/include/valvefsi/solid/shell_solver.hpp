@@ -47,6 +47,14 @@ struct ShellState {
   double stable_step = 0;              // current stable step estimate (safety applied)
   std::int64_t critical_element = -1;  // element that sets stable_step
   EnergyBalance energy;
+  // Stable-step calibration (Lanczos on M^-1 K): critical step used / element estimate.
+  double step_calibration = 1.0;
+  double highest_frequency = 0;        // omega_max of the last calibration (rad/s)
+  double calibrated_step = 0;          // 2 / omega_max at the last calibration (s)
+  double element_step_at_calibration = 0;
+  std::int64_t calibrated_at_step = -1;
+  int calibration_iterations = 0;      // Lanczos steps of the last calibration
+  Eigen::Matrix3Xd power_vector;       // last eigenvector estimate (warm start)
 };
 
 struct SymmetryConstraint {
@@ -73,6 +81,13 @@ struct SolverOptions {
   double mass_damping_per_s = 0.0;      // alpha of the damping force alpha m v (off when 0)
   int time_step_update_interval = 10;   // re-estimate the stable step every this many steps
   double max_time_step = 1e-4;          // upper bound on dt (s)
+  // Every this many steps (or when the element estimate falls below 70 % of its value then) the
+  // model's highest frequency is found by Lanczos (finite-difference K v) and the step set from
+  // it; 0 = element estimate only.
+  int time_step_calibration_interval = 0;
+  int power_iterations = 30;            // Lanczos steps at most per calibration (stops when converged)
+  double max_step_calibration = 1.5;     // the calibrated step is at most this times the element estimate
+  double fixed_time_step = 0;           // > 0: this step, no estimate (tests of the stability limit)
 };
 
 class ShellSolver {
@@ -114,6 +129,12 @@ class ShellSolver {
 
  private:
   void compute_internal_force(bool estimate_step);
+  // Internal force at x into `out`; returns the strain energy; the smallest element step
+  // estimate (no safety) and its element when `estimate_step`.
+  double evaluate_internal_force(const Eigen::Matrix3Xd& x, bool estimate_step, Eigen::Matrix3Xd& out,
+                                 double& min_step, std::int64_t& critical);
+  // Power iteration for omega_max of M^-1 K at the current state; sets state_.step_calibration.
+  void calibrate_stable_step(double element_step);
   void compute_external_force(double t, const Eigen::Matrix3Xd* nodal_forces);
   void compute_contact_force();
   void apply_constraints(Eigen::Matrix3Xd& field) const;
@@ -136,6 +157,9 @@ class ShellSolver {
   std::vector<Eigen::Matrix3Xd> thread_forces_;  // per-thread accumulation, allocated once
   Eigen::Matrix3Xd acceleration_;
   Eigen::Matrix3Xd previous_half_velocity_;  // for the damping work
+  Eigen::Matrix3Xd probe_position_, probe_force_, probe_vector_;  // calibration work arrays
+  std::vector<Eigen::Matrix3Xd> lanczos_basis_;
+  Eigen::Matrix3Xd step_increment_;
   bool internal_force_current_ = false;
   ShellState state_;
 };

@@ -51,6 +51,11 @@ RunSummary run(Solver& solver, const std::vector<std::int64_t>& free_edge, doubl
   s.last_dt = solver.state().stable_step;
   s.radius = mean_radius(solver.state().position, free_edge);
   s.error = solver.state().energy.relative_balance_error();
+  if constexpr (requires { solver.state().energy.hourglass_energy; }) {
+    const auto& e = solver.state().energy;
+    std::printf("%s: strain energy %.3e J, hourglass energy %.3e J (%.1f %% of the stored energy)\n", name,
+                e.strain_energy, e.hourglass_energy, 100 * e.hourglass_energy / (e.strain_energy + e.hourglass_energy));
+  }
   Eigen::VectorXd stress, strain;
   solver.element_fields(stress, strain);
   s.peak_stress = stress.maxCoeff();

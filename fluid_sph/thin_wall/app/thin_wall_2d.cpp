@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   double lattice_ratio = 0.5, background = 0.0, h_ratio = 1.3;
   std::string kernel = "cubic";
   double window = 1e-3;
-  bool half_plane = false, opposite_beyond_edge = false, fluid_velocity_beyond_edge = false, round_edge = false, round_edge_velocity = false;
+  bool half_plane = false, opposite_beyond_edge = false, fluid_velocity_beyond_edge = false, round_edge = false, round_edge_velocity = false, normal_continuity = false;
   OscillatingPlate plate;
   app.add_option("--scene", scene, "two_levels | gap | plate")->check(CLI::IsMember({"two_levels", "gap", "plate"}));
   app.add_option("--dp", dp, "particle spacing (m)");
@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   double attached_end_y = std::numeric_limits<double>::quiet_NaN();
   app.add_option("--attached-end-y", attached_end_y, "two_levels: y of the wall's lower end (0: flush with the floor; default buried 3 dp)");
   app.add_option("--window", window, "motion window (s): the wall's targets are set at window ends, as the coupler does");
+  app.add_flag("--normal-continuity", normal_continuity, "virtual points compress only by the wall's normal motion");
   app.add_option("--plate-width", plate.plate_width, "plate width b (m)");
   app.add_option("--amplitude", plate.amplitude, "plate amplitude A (m)");
   app.add_option("--period", plate.period, "plate period (s)");
@@ -73,6 +74,7 @@ int main(int argc, char** argv) {
   c.wall_settings.fluid_velocity_beyond_edge = fluid_velocity_beyond_edge;
   c.wall_settings.other_side_round_edge = round_edge;
   c.wall_settings.fluid_velocity_round_edge = round_edge_velocity;
+  c.wall_settings.normal_only_continuity = normal_continuity;
   const auto start = std::chrono::steady_clock::now();
   auto run = [&](auto& flow) -> int {
   std::ofstream csv;

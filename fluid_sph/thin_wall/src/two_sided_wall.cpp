@@ -256,7 +256,15 @@ void TwoSidedWall::add_wall_rates(Particles<2>& p) {
           for (int d = 0; d < 2; ++d) da[d] = mass_v * (radial * r[d] + viscous * (vva[d] - vv_v[d]));
           acc[0] += da[0];
           acc[1] += da[1];
-          cont += mass_v * vdx * F;
+          if (settings_.normal_only_continuity && !fluid_like) {
+            // Only the wall's normal motion compresses the fluid: tangential slip along the
+            // wall does not (a truncated lattice near a free end would not cancel it).
+            const Vec2 nq = wall_.normal(seg);
+            const double vn = (va[0] - vw[0]) * nq[0] + (va[1] - vw[1]) * nq[1];
+            cont += mass_v * vn * (nq[0] * r[0] + nq[1] * r[1]) * F;
+          } else {
+            cont += mass_v * vdx * F;
+          }
           csum += mass_v * wv * inv_v;
           cg[0] += mass_v * F * r[0] * inv_v;
           cg[1] += mass_v * F * r[1] * inv_v;

@@ -51,6 +51,10 @@ struct ThinWallSettings {
   // Such a virtual point moves with that side's extrapolated fluid velocity (continuity and
   // viscous terms), not with the wall.
   bool fluid_velocity_round_edge = false;
+  // In the continuity equation a virtual point moves with the fluid particle along the wall
+  // and with the wall across it: only the relative normal velocity compresses. (A measured
+  // alternative; docs/thin-leaflet.md.)
+  bool normal_only_continuity = false;
 };
 
 // What the model knows of one particle after classify (sorted index).

@@ -1,0 +1,70 @@
+#pragma once
+// The 3D thin interface as an open triangle mesh (the leaflet's mid-surface) and the geometric
+// questions the two-sided wall asks of it, as polyline.hpp does in 2D: closest point and side
+// (from the nearest feature's angle-weighted pseudo-normal, Baerentzen & Aanaes 2005), whether
+// the closest point lies on the free boundary, whether a straight segment crosses the mesh
+// (pair blocking), and whether a moving point crosses the moving mesh during a step (the
+// coplanarity cubic of Provot 1997 with an in-triangle check at each root).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace valvefsi::fluid::thin_wall {
+
+using Vec3 = std::array<double, 3>;
+
+struct TriangleMesh {
+  std::vector<Vec3> position;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+
+  // Builds the pseudo-normals and the boundary flags; call after setting or moving the nodes
+  // (the connectivity is fixed). Orientation: the normal of triangle (a, b, c) is
+  // (b - a) x (c - a), side +1 is the side it points to; neighbours must agree.
+  void update();
+
+  Vec3 face_normal(std::size_t t) const;  // unit
+  // Pseudo-normals (not normalised): vertex = angle-weighted sum of incident face normals,
+  // edge = sum of its faces' normals; edges of one triangle are the boundary.
+  std::vector<Vec3> vertex_normal;
+  std::vector<bool> vertex_on_boundary;
+  // Per triangle, edge e joins corners e and (e + 1) % 3.
+  std::vector<std::array<Vec3, 3>> edge_normal;
+  std::vector<std::array<bool, 3>> edge_on_boundary;
+};
+
+struct ClosestPoint3 {
+  std::size_t triangle = 0;
+  Vec3 barycentric{};  // of the closest point in its triangle
+  Vec3 point{};
+  double distance = 0.0;
+  int side = 1;
+  // The closest point lies on a boundary edge or vertex: beyond the free edge, going from one
+  // side to the other is legitimate (flow round the edge).
+  bool on_boundary = false;
+};
+
+ClosestPoint3 closest_point(const TriangleMesh& mesh, const Vec3& x);
+ClosestPoint3 closest_point(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles, const Vec3& x);
+
+// Where a straight segment p -> q meets the mesh (touching counts): the triangle and the
+// parameter s along p -> q.
+struct Crossing3 {
+  std::size_t triangle = 0;
+  double s = 0.0;
+};
+std::optional<Crossing3> first_crossing(const TriangleMesh& mesh, const Vec3& p, const Vec3& q);
+
+// Continuous test over a step: the point moves x0 -> x1 and the nodes before -> after, all
+// linearly in tau in [0, 1]. A root of the coplanarity cubic counts when the point is inside
+// the triangle then; an even number of events is no crossing. Returns the first event of an
+// odd count.
+struct SweptCrossing3 {
+  std::size_t triangle = 0;
+  double tau = 0.0;
+};
+std::optional<SweptCrossing3> swept_crossing(const TriangleMesh& mesh, const std::vector<Vec3>& before,
+                                             const std::vector<Vec3>& after, const Vec3& x0, const Vec3& x1);
+
+}  // namespace valvefsi::fluid::thin_wall

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "../test_meshes.hpp"
 #include "hex_test_meshes.hpp"
 #include "valvefsi/solid/hexahedron_solver.hpp"
 
@@ -121,6 +122,52 @@ TEST(HexahedronPlate, ClampedSquarePlateUnderPressureConvergesToKirchhoff) {
   EXPECT_LT(std::abs(errors[0]), 0.03);
   EXPECT_LT(std::abs(errors[1]), 0.03);
   EXPECT_LT(std::abs(errors[1] - errors[0]), 0.015);
+}
+
+TEST(HexahedronPlate, ShellAndBricksAgreeOnALargeDeflectionPlate) {
+  // The same clamped 10 x 10 mm plate, t = 0.25 mm, SVK E = 1 MPa, nu = 0.3, under 40x the load
+  // above: centre deflection ~2 t, membrane action. Shell: full plate, 16 x 16 x 2 triangles;
+  // bricks: quarter of the 16 x 16 plate. Independent element families, same physics.
+  const double a = 0.01, t = 0.25e-3, E = 1e6, nu = 0.3;
+  const double D = E * t * t * t / (12 * (1 - nu * nu));
+  const double q = 40 * 0.05 * t * D / (0.00126 * std::pow(a, 4));
+
+  const Mesh bricks = box_mesh(a / 2, a / 2, t, 8, 8, 1);
+  std::vector<std::int64_t> clamped = bricks.node_sets.at("x0");
+  clamped.insert(clamped.end(), bricks.node_sets.at("y0").begin(), bricks.node_sets.at("y0").end());
+  HexahedronSolverOptions hex_options;
+  hex_options.mass_damping_per_s = 1200.0;
+  HexahedronSolver hex(build_hexahedron_model(bricks, {1100.0, clamped}, "plate"), SolidSaintVenantKirchhoff(E, nu),
+                       hex_options);
+  std::vector<SymmetryConstraint> mirror;
+  for (const auto i : bricks.node_sets.at("x1")) mirror.push_back({i, Eigen::Vector3d::UnitX()});
+  for (const auto i : bricks.node_sets.at("y1")) mirror.push_back({i, Eigen::Vector3d::UnitY()});
+  hex.add_symmetry_constraints(mirror);
+  hex.set_pressure([q](double) { return q; }, ventricular_faces(bricks));
+  hex.advance_window(0.03);
+  double w_hex = 0;
+  for (const auto i : bricks.node_sets.at("x1")) {
+    if (std::abs(bricks.nodes(1, i) - a / 2) < 1e-12) w_hex += 0.5 * hex.displacement()(2, i);
+  }
+
+  const Mesh sheet = testing::rectangular_plate(a, a, 16, 16, t);
+  ShellModelOptions shell_options;
+  for (const char* edge : {"left", "right", "top", "bottom"}) {
+    const auto& nodes = sheet.node_sets.at(edge);
+    shell_options.fixed_nodes.insert(shell_options.fixed_nodes.end(), nodes.begin(), nodes.end());
+  }
+  SolverOptions solver_options;
+  solver_options.mass_damping_per_s = 1200.0;
+  ShellSolver shell(build_shell_model(sheet, shell_options), SaintVenantKirchhoff(E, nu), solver_options);
+  shell.set_pressure([q](double) { return q; });
+  shell.advance_window(0.03);
+  const double w_shell = shell.displacement()(2, testing::grid_node(8, 8, 16));
+
+  std::printf("large-deflection plate: centre %.4f mm (bricks) vs %.4f mm (shell): %+.2f %%; linear Kirchhoff %.4f mm\n",
+              w_hex * 1e3, w_shell * 1e3, 100 * (w_hex / w_shell - 1), 40 * 0.05 * t * 1e3);
+  EXPECT_GT(w_shell, t);                        // large deflection: membrane action
+  EXPECT_LT(w_shell, 0.8 * 40 * 0.05 * t);      // well below the linear answer
+  EXPECT_NEAR(w_hex / w_shell, 1.0, 0.05);
 }
 
 TEST(HexahedronDynamics, UndampedFreeVibrationConservesEnergy) {

@@ -170,6 +170,43 @@ TEST(HexahedronPlate, ShellAndBricksAgreeOnALargeDeflectionPlate) {
   EXPECT_NEAR(w_hex / w_shell, 1.0, 0.05);
 }
 
+TEST(HexahedronLocking, NearlyIncompressibleThickCylinderUnderPressure) {
+  // Lame: quarter of a thick cylinder a = 5 mm, b = 10 mm in plane strain, internal pressure p,
+  // neo-Hookean kappa = 5000 mu (nu = 0.4999): u_r(a) = p a^2 / (2 mu (b^2 - a^2)) [(1 - 2 nu) a + b^2 / a].
+  // The classic volumetric-locking case (fully integrated bricks give a fraction of it).
+  const double a = 0.005, b = 0.01, mu = 1e5, kappa = 5000 * mu, p = 10.0;
+  const double nu = (3 * kappa - 2 * mu) / (2 * (3 * kappa + mu));
+  const int nr = 8, nt = 8;
+  Mesh mesh = box_mesh(b - a, M_PI / 2, 0.5e-3, nr, nt, 1);
+  for (Eigen::Index n = 0; n < mesh.nodes.cols(); ++n) {
+    const double r = a + mesh.nodes(0, n), theta = mesh.nodes(1, n);
+    mesh.nodes.col(n) = Eigen::Vector3d(r * std::cos(theta), r * std::sin(theta), mesh.nodes(2, n));
+  }
+  HexahedronSolverOptions options;
+  options.mass_damping_per_s = 3000.0;
+  HexahedronSolver solver(build_hexahedron_model(mesh, {1100.0, {}}, "cylinder"), SolidNeoHookean(mu, kappa), options);
+  std::vector<SymmetryConstraint> constraints;
+  for (Eigen::Index n = 0; n < mesh.nodes.cols(); ++n) constraints.push_back({n, Eigen::Vector3d::UnitZ()});
+  for (const auto n : mesh.node_sets.at("y0")) constraints.push_back({n, Eigen::Vector3d::UnitY()});
+  for (const auto n : mesh.node_sets.at("y1")) constraints.push_back({n, Eigen::Vector3d::UnitX()});
+  solver.add_symmetry_constraints(constraints);
+  // Inner faces (box face x = 0), ordered so that their normal points into the wall (+r).
+  std::vector<PressureFace> inner;
+  for (int j = 0; j < nt; ++j) {
+    inner.push_back({testing::box_node(0, j, 0, nr, nt), testing::box_node(0, j + 1, 0, nr, nt),
+                     testing::box_node(0, j + 1, 1, nr, nt), testing::box_node(0, j, 1, nr, nt)});
+  }
+  solver.set_pressure([p](double) { return p; }, inner);
+  solver.advance_window(0.008);
+  double u = 0;
+  for (const auto n : mesh.node_sets.at("x0")) u += solver.displacement().col(n).head<2>().norm();
+  u /= static_cast<double>(mesh.node_sets.at("x0").size());
+  const double expected = p * a * a / (2 * mu * (b * b - a * a)) * ((1 - 2 * nu) * a + b * b / a);
+  std::printf("thick cylinder, nu = %.4f, %d x %d bricks: u_r(a) %.5g um, Lame %.5g um, error %+.2f %%\n", nu, nr, nt,
+              u * 1e6, expected * 1e6, 100 * (u / expected - 1));
+  EXPECT_NEAR(u / expected, 1.0, 0.03);
+}
+
 TEST(HexahedronDynamics, UndampedFreeVibrationConservesEnergy) {
   // MHGO cantilever (reference Table 1, kappa = 2/D) released with a bending velocity field.
   Cantilever c = cantilever(10, SolidMhgo(), 0.0, false);

@@ -111,7 +111,7 @@ void implicit_damper_converges(const std::string& acceleration, int max_mean_ite
   const double c = 5000.0, dt = 1e-3;
   CoupledRun run(plate_run("implicit-" + acceleration, 0.02,
                            "scheme: SERIAL_IMPLICIT acceleration: " + acceleration +
-                               " relative_tolerance: 1e-10 max_iterations: 60 relaxation_factor: 0.5 window_size: 1e-3",
+                               " relative_tolerance: 1e-10 absolute_tolerance: 0 max_iterations: 60 relaxation_factor: 0.5 window_size: 1e-3",
                            "standin_fluid_damper", {"--pressure", "100", "--damping", "5000"}));
   expect_all_ended_ok(run);
   Plate plate;
@@ -140,6 +140,29 @@ void implicit_damper_converges(const std::string& acceleration, int max_mean_ite
 TEST(CoupledRun, SerialImplicitConstantRelaxationConvergesToTheFixedPoint) { implicit_damper_converges("CONSTANT_RELAXATION", 170); }
 TEST(CoupledRun, SerialImplicitAitkenConvergesToTheFixedPoint) { implicit_damper_converges("AITKEN", 35); }
 TEST(CoupledRun, SerialImplicitIqnIlsConvergesToTheFixedPoint) { implicit_damper_converges("IQN_ILS", 35); }
+
+// The absolute criterion ends a window whose solid motion changes by less than
+// absolute_tolerance (RMS per node), whatever the relative change: a solid at rest amid fluid
+// noise would otherwise never converge. Here the plate moves ~1e-3 m per window, so a 1 m
+// tolerance accepts the first pass of every window and 0 never does.
+TEST(CoupledRun, SerialImplicitAbsoluteToleranceEndsTheWindow) {
+  for (const double tolerance : {0.0, 1.0}) {
+    CoupledRun run(plate_run("implicit-absolute-" + std::to_string(static_cast<int>(tolerance)), 0.01,
+                             "scheme: SERIAL_IMPLICIT acceleration: IQN_ILS relative_tolerance: 1e-10 "
+                             "max_iterations: 60 window_size: 1e-3 absolute_tolerance: " + std::to_string(tolerance),
+                             "standin_fluid_damper", {"--pressure", "100", "--damping", "5000"}));
+    expect_all_ended_ok(run);
+    const auto iterations = read_series(run.dir / "coupling_series.h5", "iterations");
+    ASSERT_EQ(iterations.size(), 10u);
+    for (std::size_t i = 0; i < iterations.size(); ++i) {
+      if (tolerance > 0.0) {
+        EXPECT_EQ(iterations[i], 1.0) << "window " << i;
+      } else {
+        EXPECT_GE(iterations[i], 2.0) << "window " << i;
+      }
+    }
+  }
+}
 
 TEST(CoupledRun, WindowIsTheSmallestOfCaseAndProposalsAndLandsOnTheEndTime) {
   RunSpec spec = plate_run("window", 0.0101, "window_size: 1e-3", "standin_fluid_pressure", {"--propose-window", "4e-4"});

@@ -70,7 +70,7 @@ const double kMonolithicAcceleration = kExternalForce / (kStructureMass + kAdded
 Outcome incompressible(const std::string& name, double omega, double end_time, int max_iterations) {
   const std::string a0 = format(kMonolithicAcceleration);
   return run(name, end_time,
-             "scheme: SERIAL_IMPLICIT acceleration: CONSTANT_RELAXATION window_size: 1e-3 relative_tolerance: 1e-10"
+             "scheme: SERIAL_IMPLICIT acceleration: CONSTANT_RELAXATION window_size: 1e-3 relative_tolerance: 1e-10 absolute_tolerance: 0"
              " max_iterations: " + std::to_string(max_iterations) + " relaxation_factor: " + format(omega),
              {"--model", "incompressible", "--density", "1000", "--column-length", "0.1", "--area", "1e-4",
               "--initial-acceleration", a0},
@@ -100,7 +100,7 @@ TEST(ModelProblemsThroughCoupler, IncompressiblePistonRelaxationDivergesJustAbov
 // keeps c dt / dx <= 1 safe from rounding): dt = 5e-5 s; m'' = rho c dt / mu; 100 Pa drive.
 Outcome acoustic(const std::string& name, const std::string& scheme, double mu, int windows) {
   const double mass = 1000.0 * 10.0 * 5e-5 / mu;
-  return run(name, windows * 5e-5, scheme + " window_size: 5e-5 relative_tolerance: 1e-12 max_iterations: 200 relaxation_factor: 0.1",
+  return run(name, windows * 5e-5, scheme + " window_size: 5e-5 relative_tolerance: 1e-12 absolute_tolerance: 0 max_iterations: 200 relaxation_factor: 0.1",
              {"--model", "acoustic", "--density", "1000", "--sound-speed", "10", "--column-length", "0.1", "--cells", "100",
               "--area", "1"},
              {"--model", "piston", "--mass", format(mass), "--external-force", "100", "--initial-acceleration",
@@ -144,7 +144,7 @@ TEST(ModelProblemsThroughCoupler, AcousticPistonIqnIlsConvergesBeyondBothExplici
 
 // ---------------------------------------------------------------- nonlinear fixed point
 TEST(ModelProblemsThroughCoupler, NonlinearFixedPointIqnIlsFindsTheRootPlainIterationDoesNot) {
-  const std::string common = "scheme: SERIAL_IMPLICIT window_size: 1 relative_tolerance: 1e-12 max_iterations: 60 ";
+  const std::string common = "scheme: SERIAL_IMPLICIT window_size: 1 relative_tolerance: 1e-12 absolute_tolerance: 0 max_iterations: 60 ";
   const auto iqn = run("mp-fixed-iqn", 1.0, common + "acceleration: IQN_ILS relaxation_factor: 0.1",
                        {"--model", "fixed-point", "--area", "1"}, {"--model", "fixed-point", "--area", "1"});
   ASSERT_TRUE(all_ok(iqn)) << iqn.coupler_log;

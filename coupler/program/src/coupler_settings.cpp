@@ -37,6 +37,7 @@ CouplerSettings settings_from_case(const cases::Case& run_case, const std::files
   settings.acceleration.relaxation = coupling.relaxation_factor();
   settings.acceleration.reused_windows = coupling.iqn_reused_windows();
   settings.relative_tolerance = coupling.relative_tolerance();
+  settings.absolute_tolerance = coupling.absolute_tolerance();
   settings.max_iterations = coupling.max_iterations();
   settings.window_size = coupling.window_size();
   settings.end_time = run_case.run().end_time();

@@ -90,7 +90,9 @@ WindowRecord serial_implicit_window(WindowExchange& exchange, const CouplerSetti
     record.iterations = k + 1;
     record.relative_residual = residual;
     proposals = {fluid.max_stable_window, reply.max_stable_window};
-    record.converged = residual < settings.relative_tolerance;
+    // Relative to the displacement, or absolute for a solid (nearly) at rest.
+    const double rms_change = (output - input).norm() / std::sqrt(static_cast<double>(std::max<Eigen::Index>(output.size() / 3, 1)));
+    record.converged = residual < settings.relative_tolerance || rms_change < settings.absolute_tolerance;
     if (record.converged || k + 1 >= settings.max_iterations) {
       acceleration.end_window();
       exchange.send_converged(window.time + window.size, static_cast<std::uint32_t>(k + 1), residual, record.converged);

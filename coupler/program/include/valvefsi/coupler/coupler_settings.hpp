@@ -18,6 +18,7 @@ struct CouplerSettings {
   SchemeKind scheme = SchemeKind::serial_explicit;
   coupling::AccelerationOptions acceleration;
   double relative_tolerance = 1e-4;
+  double absolute_tolerance = 1e-9;  // m, RMS over the solid's nodes
   int max_iterations = 50;
   double window_size = 1e-3;   // s, the largest window
   double end_time = 0.0;       // s

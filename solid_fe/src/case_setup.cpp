@@ -125,6 +125,7 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.time_step_update_interval = solid.time_step_update_interval();
   solver_options.time_step_calibration_interval = solid.time_step_calibration_interval();
   solver_options.max_step_calibration = solid.max_time_step_calibration();
+  solver_options.max_time_step_growth = solid.max_time_step_growth();
   solver_options.mass_damping_per_s = solid.mass_damping_per_s();
   solver_options.max_time_step = solid.max_time_step();
   solver_options.contact_stiffness_factor = solid.contact_stiffness_factor();
@@ -153,8 +154,7 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
     setup.solver->add_symmetry_constraints(on_plane);
   }
   for (const auto& [name, plane] : mesh.contact_planes) {
-    setup.notes.push_back(fmt::format("contact plane '{}': penalty contact of the mid-surface offset by t/2 "
-                                      "(leaflet-leaflet contact is NOT implemented yet)", name));
+    setup.notes.push_back(fmt::format("contact plane '{}': penalty contact of the mid-surface offset by t/2", name));
     setup.solver->add_contact_plane(plane);
   }
   for (int k = 0; k < solid.contact_cylinders_size(); ++k) {

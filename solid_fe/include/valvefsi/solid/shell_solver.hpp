@@ -87,6 +87,7 @@ struct SolverOptions {
   int time_step_calibration_interval = 0;
   int power_iterations = 30;            // Lanczos steps at most per calibration (stops when converged)
   double max_step_calibration = 1.5;     // the calibrated step is at most this times the element estimate
+  double max_time_step_growth = 0;       // > 0: dt grows by at most this fraction per step
   double fixed_time_step = 0;           // > 0: this step, no estimate (tests of the stability limit)
 };
 

@@ -269,6 +269,7 @@ std::unique_ptr<ImmersedSurfaceModel<2>> make_thin_wall_model_2d(const ImmersedS
   ThinWallSettings settings;
   settings.virtual_spacing_ratio = checked.virtual_spacing_ratio();
   settings.clearance_ratio = checked.clearance_ratio();
+  settings.wall_acceleration_in_pressure = checked.wall_acceleration_in_pressure();
   return std::make_unique<ThinWallModel2D>(geometry, fluid, settings);
 }
 

@@ -1,5 +1,7 @@
 #include "valvefsi/fluid/fluid_solver.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -395,6 +397,17 @@ void FluidSolver<D>::choose_time_step() {
   if (max_acceleration_ > 0) dt = std::min(dt, s.cfl * std::sqrt(h / max_acceleration_));  // force
   if (s.dynamic_viscosity > 0) dt = std::min(dt, 0.125 * h * h * s.rest_density / s.dynamic_viscosity);  // viscous (Morris et al. 1997)
   dt_ = std::min(dt, s.max_time_step);
+  double dt_at_rest = std::min(s.cfl * h / s.sound_speed, s.max_time_step);
+  if (s.dynamic_viscosity > 0) dt_at_rest = std::min(dt_at_rest, 0.125 * h * h * s.rest_density / s.dynamic_viscosity);
+  if (s.min_time_step_ratio > 0 && dt_ < s.min_time_step_ratio * dt_at_rest) {
+    throw std::runtime_error(fmt::format(
+        "time step collapsed at t = {:.6g} s: dt = {:.3g} s < {:g} x the step at rest ({:.3g} s); "
+        "limits: largest fluid speed {:.3g} m/s, leaflet node speed {:.3g} m/s, largest acceleration {:.3g} m/s^2 "
+        "(a particle squeezed between walls or a blow-up); lower the window or the CFL, raise the sound speed, "
+        "or set fluid.min_time_step_ratio to go on",
+        time_, dt_, s.min_time_step_ratio, dt_at_rest, max_speed_, surface_ ? surface_->max_node_speed() : 0.0,
+        max_acceleration_));
+  }
 }
 
 template <int D>

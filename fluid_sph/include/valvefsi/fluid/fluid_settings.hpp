@@ -43,6 +43,8 @@ struct FluidSettings {
   // A fluid particle whose |rho - rho0| exceeds this fraction of rho0 is taken out of the
   // run (counted as lost), as DualSPHysics does with RhopOutMin/Max (700-1300 for water).
   double max_density_deviation = 0.3;
+  // Stop when dt < this x the step at rest (acoustic, viscous, max_time_step; 0: never).
+  double min_time_step_ratio = 1e-3;
   double cfl = 0.2;                     // Courant number of the acoustic and force limits
   double max_time_step = std::numeric_limits<double>::infinity();  // s
   int sort_interval = 1;                // re-sort particles by cell every this many steps

@@ -1,0 +1,127 @@
+"""How a run ended, from its exit code, the programs' logs and its series.
+
+Kinds (docs/stability-map.md), first match wins:
+- `completed`: exit 0 and the series reach the end time, with no leak and bounded energy;
+- `nan`: a program or the transport reported a non-finite value;
+- `time-step collapse`: the fluid's time-step guard stopped the run;
+- `solid failure`: the solid could not evaluate its material (inverted element, overflow);
+- `coupling divergence`: implicit windows left unconverged, or the interface force left any
+  physical bound (explicit coupling: |F| > `force_bound` N/m);
+- `leaks`: particles crossed a leaflet (fluid_probes.h5 interface/leaks > 0) -- the programs
+  count them but do not stop, so a completed run can end in this class;
+- `energy growth`: a leaflet's free edge faster than `speed_bound` (50 m/s, 30x the Bernoulli
+  jet speed of the waveform; the committed 2D case's upper leaflet flutters at up to 23 m/s
+  between 70 and 120 ms and completes, measured). The solid's own energy balance
+  error is not used: in coupled runs it is the balance of ~1e-7 J terms and reaches 0.3 in
+  the first 10 ms of a sound run (measured);
+- `timeout`: stopped at the sweep's wall-time limit;
+- `other`: any other failure (the first error line is kept).
+Detection by the programs is recorded apart from the class: `detected_by` names the program
+whose message stopped the run, or is empty when the class comes only from this post-mortem.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+FORCE_BOUND_N_PER_M = 500.0   # 2D: ~10x the largest transvalvular load (97 mmHg over 23 mm = 298 N/m)
+SPEED_BOUND_M_PER_S = 50.0
+
+PATTERNS = [  # (kind, regex on a log line), checked on error lines first
+    ("nan", re.compile(r"\bnan\b|not finite|non-finite|infinit", re.IGNORECASE)),
+    ("time-step collapse", re.compile(r"time step collapsed", re.IGNORECASE)),
+    ("solid failure", re.compile(r"inverted|overflow|material", re.IGNORECASE)),
+    ("coupling divergence", re.compile(r"diverg|not converged", re.IGNORECASE)),
+]
+ERROR_LINE = re.compile(r"\[(error|critical)\]|run_case: .*failed|error:", re.IGNORECASE)
+
+
+@dataclass
+class Outcome:
+    kind: str
+    detail: str          # the message (first error line) or the measured quantity
+    detected_by: str     # program whose message stopped the run ('' = not stopped by a program)
+    reached_s: float | None
+    unconverged_windows: int = 0
+
+
+def _lines(path: Path) -> list[str]:
+    try:
+        return path.read_text(errors="replace").splitlines()
+    except OSError:
+        return []
+
+
+def _reached(run_dir: Path) -> float | None:
+    import h5py
+    for name, key in (("coupling_series.h5", "time"), ("solid_series.h5", "time"), ("fluid_probes.h5", "time")):
+        try:
+            with h5py.File(run_dir / name, "r") as f:
+                t = f[key][...]
+                if len(t):
+                    return float(np.max(t))
+        except (OSError, KeyError):
+            continue
+    return None
+
+
+def _coupling_series(run_dir: Path):
+    import h5py
+    try:
+        with h5py.File(run_dir / "coupling_series.h5", "r") as f:
+            return {k: f[k][...] for k in ("time", "force_fluid", "iterations", "relative_residual") if k in f}
+    except OSError:
+        return {}
+
+
+def classify(run_dir: Path, exit_code: int, end_time: float, timed_out: bool = False,
+             launcher_log: Path | None = None, leaks: int | None = None, max_edge_speed: float | None = None,
+             force_bound: float = FORCE_BOUND_N_PER_M, speed_bound: float = SPEED_BOUND_M_PER_S) -> Outcome:
+    run_dir = Path(run_dir)
+    reached = _reached(run_dir)
+    logs = {role: _lines(run_dir / f"{role}.log") for role in ("fluid", "solid", "coupler")}
+    if launcher_log is not None:
+        logs["launcher"] = _lines(launcher_log)
+    unconverged = sum(1 for line in logs["coupler"] if re.search(r"not converged after \d+ iterations", line))
+    series = _coupling_series(run_dir)
+    force_max = None
+    if "force_fluid" in series and len(series["force_fluid"]):
+        finite = np.isfinite(series["force_fluid"]).all()
+        force_max = float(np.abs(series["force_fluid"]).max()) if finite else float("inf")
+
+    if exit_code != 0:
+        # the program that failed first is named by the launcher; its error lines say why
+        first = next((m.group(1) for line in logs.get("launcher", [])
+                      for m in [re.search(r"run_case: (\w+) failed with exit code", line)] if m), "")
+        ordered = ([first] if first in logs else []) + [r for r in ("fluid", "solid", "coupler") if r != first]
+        errors = [(role, line) for role in ordered for line in logs[role] if ERROR_LINE.search(line)]
+        for kind, pattern in PATTERNS:
+            for role, line in errors:
+                if pattern.search(line):
+                    return Outcome(kind, line.strip()[-400:], role, reached, unconverged)
+        if timed_out:
+            return Outcome("timeout", f"stopped at the wall-time limit at t = {reached}", "", reached, unconverged)
+        if force_max is not None and force_max > force_bound:
+            return Outcome("coupling divergence", f"|interface force| reached {force_max:.3g} N/m "
+                           f"(exit code {exit_code}, no program named it)", "", reached, unconverged)
+        detail = errors[0][1].strip()[-400:] if errors else f"exit code {exit_code}, no error line in the logs"
+        return Outcome("other", detail, errors[0][0] if errors else "", reached, unconverged)
+
+    if reached is None or reached < end_time - 1e-9:
+        return Outcome("other", f"exit 0 but the series end at t = {reached}", "", reached, unconverged)
+    if force_max is not None and force_max > force_bound:
+        return Outcome("coupling divergence", f"completed, but |interface force| reached {force_max:.3g} N/m",
+                       "", reached, unconverged)
+    if unconverged:
+        return Outcome("coupling divergence", f"completed with {unconverged} unconverged implicit windows (warnings only)",
+                       "", reached, unconverged)
+    if leaks:
+        return Outcome("leaks", f"completed with {leaks} particle(s) through a leaflet (counted, not stopped)",
+                       "", reached, unconverged)
+    if max_edge_speed is not None and max_edge_speed > speed_bound:
+        return Outcome("energy growth", f"completed, but a free edge reached {max_edge_speed:.3g} m/s",
+                       "", reached, unconverged)
+    return Outcome("completed", "", "", reached, unconverged)

@@ -1,0 +1,41 @@
+"""The sweeps behind docs/speed-accuracy.md and docs/stability-map.md.
+
+Costs were chosen for a 2-core machine shared by others: one run at a time, one thread each,
+spans as short as the question allows (stated in `span`).
+"""
+from __future__ import annotations
+
+OPENING_END_S = 0.10
+
+PRESETS = {
+    # Speed against accuracy: particle spacing x sound speed on the 2D valve's opening.
+    "opening-2d": {
+        "scene": "valve2d",
+        "end_time": OPENING_END_S,
+        "span": "opening only, 0-100 ms of the first cycle (no EOA, RVCT, diastolic force or closed stress)",
+        "base": {"material": "MHGO"},
+        "grid": {"spacing_mm": [2.0, 1.5, 1.0], "sound_speed": [10.0, 20.0, 40.0]},
+        "runs": [{"group": "finest", "setting": {"spacing_mm": 0.75, "sound_speed": 40.0}}],
+        "finest": {"spacing_mm": 0.75, "sound_speed": 40.0},
+        "wall_limit_s": 3600,
+    },
+    # Stability map: each group varies one thing from the committed coarse case (the default
+    # run, shared by every group, is listed in the first).
+    "stability-2d": {
+        "scene": "valve2d",
+        "end_time": 0.03,
+        "span": "0-30 ms of the first cycle (start-up and the first pressure wave; the leaflets start to open at 30-50 ms)",
+        "base": {"material": "MHGO"},
+        "runs": (
+            [{"group": "time-step factor", "setting": {}}]
+            + [{"group": "time-step factor", "setting": {"time_step_factor": f}} for f in (1.5, 2.0, 3.0)]
+            + [{"group": "sound speed", "setting": {"sound_speed": c}} for c in (2.5, 5.0, 10.0)]
+            + [{"group": "added mass, explicit", "setting": {"leaflet_density": rho}} for rho in (550.0, 275.0, 110.0)]
+            + [{"group": "added mass, implicit", "setting": {"leaflet_density": rho, "coupling": "implicit"}}
+               for rho in (275.0, 110.0)]
+            + [{"group": "density diffusion", "setting": {"density_diffusion": 0.0}}]
+            + [{"group": "thickness / spacing", "setting": {"thickness_mm": t}} for t in (0.5, 0.125, 0.0625)]
+        ),
+        "wall_limit_s": 900,
+    },
+}

@@ -1,0 +1,206 @@
+"""The sweep tool's pieces on synthetic inputs (no programs run): case editing, the opening
+metrics, the classification of a run's end, and the choice of the cheapest setting."""
+import json
+import tempfile
+import unittest
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from sweep import case_edit, metrics, outcome, plan, report, scenes
+
+CASE = """# comment
+title: "x"
+run {
+  end_time: 1.6
+  output_dir: "runs/a"
+}
+fluid {
+  particle_spacing: 0.001
+  sound_speed: 20  # trailing comment
+  thin_walls { virtual_spacing_ratio: 0.5 }
+}
+coupling {
+  scheme: SERIAL_EXPLICIT
+}
+"""
+
+
+class CaseEdit(unittest.TestCase):
+    def test_replaces_an_existing_field_and_keeps_the_rest(self):
+        text = case_edit.set_field(CASE, "fluid.sound_speed", 40.0)
+        self.assertIn("  sound_speed: 40\n", text)
+        self.assertEqual(text.count("sound_speed"), 1)
+        self.assertIn("thin_walls { virtual_spacing_ratio: 0.5 }", text)
+        self.assertEqual(case_edit.get_field(text, "fluid.particle_spacing"), "0.001")
+
+    def test_adds_a_missing_field_inside_its_block(self):
+        text = case_edit.set_field(CASE, "coupling.acceleration", "IQN_ILS")
+        block = text[text.index("coupling {"):]
+        self.assertIn("  acceleration: IQN_ILS\n}", block)
+
+    def test_adds_a_missing_block(self):
+        text = case_edit.set_field(CASE, "solid.density", 550.0)
+        self.assertTrue(text.endswith("solid {\n  density: 550\n}\n"))
+
+    def test_literals(self):
+        self.assertEqual(case_edit.format_value(True), "true")
+        self.assertEqual(case_edit.format_value("SERIAL_IMPLICIT"), "SERIAL_IMPLICIT")
+        self.assertEqual(case_edit.format_value("run"), '"run"')
+        self.assertEqual(case_edit.format_value(6.5e-6), "6.5e-06")
+
+    def test_a_nested_path_is_refused_with_what_is_allowed(self):
+        with self.assertRaisesRegex(ValueError, "block.field"):
+            case_edit.set_field(CASE, "fluid.thin_walls.virtual_spacing_ratio", 1.0)
+
+    def test_replace_block(self):
+        text = case_edit.replace_block(CASE, "fluid", "fluid {\n  particle_spacing: 0.002\n}\n")
+        self.assertEqual(case_edit.get_field(text, "fluid.particle_spacing"), "0.002")
+        self.assertIsNone(case_edit.get_field(text, "fluid.sound_speed"))
+        self.assertIn("coupling {", text)
+
+
+class Valve2dScene(unittest.TestCase):
+    def test_setting_reaches_the_case(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            case = scenes.write_case("valve2d", {"spacing_mm": 23.0 / 12.0, "sound_speed": 40.0, "time_step_factor": 2.0,
+                                                 "coupling": "implicit", "leaflet_density": 550.0,
+                                                 "background_pressure": "off", "thickness_mm": 0.125},
+                                     Path(tmp) / "w", 0.05)
+            text = case.read_text()
+            get = lambda p: case_edit.get_field(text, p)
+            self.assertAlmostEqual(float(get("fluid.particle_spacing")), 23e-3 / 12, delta=1e-11)
+            self.assertEqual(float(get("fluid.sound_speed")), 40.0)
+            self.assertAlmostEqual(float(get("fluid.cfl")), 0.4)
+            # mu = 1 window at c0 = 40 for the default leaflet (1100 kg/m^3, 0.25 mm): 3.0 us, doubled
+            self.assertAlmostEqual(float(get("coupling.window_size")), 6.0e-6)
+            self.assertEqual(get("coupling.scheme"), "SERIAL_IMPLICIT")
+            self.assertEqual(get("coupling.acceleration"), "IQN_ILS")
+            self.assertEqual(float(get("solid.density")), 550.0)
+            self.assertEqual(float(get("fluid.background_pressure")), 0.0)
+            self.assertEqual(float(get("run.end_time")), 0.05)
+            mesh = Path(tmp) / "w" / get("solid.mesh_file").strip('"')
+            with h5py.File(mesh, "r") as f:
+                self.assertTrue(len(f.keys()) > 0)
+
+    def test_unknown_axis_is_named(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            with self.assertRaisesRegex(ValueError, "unknown axis 'spacing'"):
+                scenes.write_case("valve2d", {"spacing": 1.0}, Path(tmp), 0.01)
+
+    def test_mu_of_the_default_is_one_and_scales_with_the_leaflet_mass(self):
+        from sweep import stability
+        self.assertAlmostEqual(stability.mu_of({}), 1.0, delta=0.03)
+        self.assertAlmostEqual(stability.mu_of({"leaflet_density": 275.0}) / stability.mu_of({}), 4.0, places=9)
+
+
+class OpeningEvents(unittest.TestCase):
+    def test_linear_ramp(self):
+        t = np.linspace(0, 0.12, 1201)
+        r = np.clip((t - 0.03) / 0.05, 0, 1) * 10e-3 + 1e-3   # opens from 30 to 80 ms
+        e = metrics.opening_events(t, r)
+        self.assertAlmostEqual(e["opening_start"], 0.035, delta=1e-4)
+        self.assertAlmostEqual(e["rvot"], 0.040, delta=2e-4)
+
+    def test_a_valve_that_stays_shut_has_no_events(self):
+        t = np.linspace(0, 0.04, 401)
+        self.assertEqual(metrics.opening_events(t, np.full_like(t, 1e-3)), {})
+        # a dip (leaflets pushed back) before the opening does not count as opening
+        r = 1e-3 - 1e-4 * np.sin(np.pi * t / 0.04)
+        self.assertEqual(metrics.opening_events(t, r), {})
+
+
+def write_logs(run_dir: Path, logs: dict):
+    run_dir.mkdir(parents=True, exist_ok=True)
+    for role, text in logs.items():
+        (run_dir / f"{role}.log").write_text(text)
+
+
+def write_coupling(run_dir: Path, t, force):
+    with h5py.File(run_dir / "coupling_series.h5", "w") as f:
+        f["time"] = np.asarray(t, float)
+        f["force_fluid"] = np.asarray(force, float)
+
+
+class Classify(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = Path(self.tmp.name) / "run"
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_time_step_collapse_named_by_the_fluid(self):
+        write_logs(self.dir, {"fluid": "[x] [error] fluid_sph: time step collapsed at t = 0.061 s: dt = 1e-9 s\n",
+                              "coupler": "[x] [error] coupler: participant 'fluid' aborted\n", "solid": ""})
+        write_coupling(self.dir, [0.01, 0.02], np.zeros((2, 3)))
+        launcher = Path(self.tmp.name) / "launcher.log"
+        launcher.write_text("run_case: fluid failed with exit code 1; stopping coupler, solid\n")
+        o = outcome.classify(self.dir, 1, 0.1, launcher_log=launcher)
+        self.assertEqual((o.kind, o.detected_by), ("time-step collapse", "fluid"))
+        self.assertAlmostEqual(o.reached_s, 0.02)
+
+    def test_nan_reported_by_the_coupler(self):
+        write_logs(self.dir, {"coupler": "[error] coupler: NaN in 'loads' from participant 'fluid' at point 3\n"})
+        self.assertEqual(outcome.classify(self.dir, 5, 0.1).kind, "nan")
+
+    def test_unnamed_failure_with_a_runaway_force_is_divergence_not_detected(self):
+        write_logs(self.dir, {"coupler": "", "fluid": "", "solid": ""})
+        write_coupling(self.dir, [0.01, 0.02, 0.03], [[1, 0, 0], [100, 0, 0], [1e4, 0, 0]])
+        o = outcome.classify(self.dir, 1, 0.1)
+        self.assertEqual((o.kind, o.detected_by), ("coupling divergence", ""))
+
+    def test_completed_with_leaks_and_with_unconverged_windows(self):
+        write_logs(self.dir, {"coupler": "", "fluid": "", "solid": ""})
+        write_coupling(self.dir, [0.05, 0.1], np.ones((2, 3)))
+        self.assertEqual(outcome.classify(self.dir, 0, 0.1, leaks=3).kind, "leaks")
+        self.assertEqual(outcome.classify(self.dir, 0, 0.1, max_edge_speed=60.0).kind, "energy growth")
+        self.assertEqual(outcome.classify(self.dir, 0, 0.1).kind, "completed")
+        write_logs(self.dir, {"coupler": "[warning] coupler: window 7 (t = 1e-4 s) not converged after 30 iterations\n"})
+        self.assertEqual(outcome.classify(self.dir, 0, 0.1).kind, "coupling divergence")
+
+    def test_run_short_of_its_end_is_not_completed(self):
+        write_logs(self.dir, {"coupler": "", "fluid": "", "solid": ""})
+        write_coupling(self.dir, [0.05], np.ones((1, 3)))
+        self.assertEqual(outcome.classify(self.dir, 0, 0.1).kind, "other")
+
+
+def fake_result(label, cpu, m, kind="completed"):
+    return {"label": label, "groups": ["grid"], "setting": {"spacing_mm": label}, "end_time": 0.12, "span": "s",
+            "cost": {"wall_s": cpu, "cpu_s": cpu, "peak_rss_mb_by_program": {}}, "core_hours": cpu / 3600,
+            "outcome": {"kind": kind, "reached_s": 0.12, "detail": "", "detected_by": ""}, "metrics": m,
+            "reference_errors": {}}
+
+
+class CheapestWithin(unittest.TestCase):
+    def test_picks_the_cheapest_run_within_tolerance_on_every_metric(self):
+        finest = fake_result("f", 100, {"peak_velocity": 1.0, "rvot": 0.040})
+        results = [finest,
+                   fake_result("a", 1, {"peak_velocity": 1.2, "rvot": 0.040}),      # velocity 20 % off
+                   fake_result("b", 5, {"peak_velocity": 1.04, "rvot": 0.0415}),    # within 5 %
+                   fake_result("c", 2, {"peak_velocity": 1.01, "rvot": 0.040}, kind="nan"),  # failed
+                   fake_result("d", 3, {"peak_velocity": 1.01})]                   # lacks RVOT
+        rows = report.with_errors(results, finest)
+        self.assertEqual(report.cheapest_within(rows, finest, 0.05)["label"], "b")
+        text = report.markdown(results, "f")
+        self.assertIn("**b**", text)
+        with tempfile.TemporaryDirectory() as tmp:
+            report.chart(results, Path(tmp) / "c.png", "f")
+            self.assertGreater((Path(tmp) / "c.png").stat().st_size, 1000)
+
+
+class Plan(unittest.TestCase):
+    def test_a_setting_in_two_groups_runs_once(self):
+        spec = {"scene": "valve2d", "end_time": 0.01, "base": {"material": "MHGO"},
+                "runs": [{"group": "a", "setting": {"sound_speed": 20.0}},
+                         {"group": "b", "setting": {"sound_speed": 20.0}},
+                         {"group": "b", "setting": {"sound_speed": 10.0}}]}
+        runs = plan.expand(spec)
+        self.assertEqual(len(runs), 2)
+        self.assertEqual(runs[0].groups, ["a", "b"])
+        json.dumps([r.setting for r in runs])
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -31,10 +31,10 @@ constexpr int kExitSolidFailure = 6;  // the solid's own failure (material state
 class CoupledOutput {
  public:
   CoupledOutput(const cases::Case& c, const std::filesystem::path& dir, const SolidSetup& setup)
-      : fields_(dir, setup.mesh), series_(dir, monitors_of(setup)),
+      : fields_(dir, setup.mesh, setup.element_family), series_(dir, monitors_of(setup)),
         snapshot_interval_(c.run().snapshot_interval()), series_interval_(c.run().series_interval()) {}
 
-  void accepted(const ShellSolver& solver, bool last) {
+  void accepted(const ExplicitSolver& solver, bool last) {
     const double t = solver.state().time;
     if (t >= next_sample_ - 1e-12 || last || samples_ == 0) {
       series_.sample(solver, 0.0);  // no prescribed pressure in coupled mode
@@ -81,11 +81,12 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
   const auto wall_start = Clock::now();
   SolidSetup setup = setup_from_case(c, case_file);
   for (const auto& note : setup.notes) spdlog::info("{}", note);
-  ShellSolver& solver = *setup.solver;
-  const SolidInterface interface = setup.dimension == 2
-                                       ? strip_interface(setup.mesh, setup.strip_ties, setup.strip_depth,
-                                                         setup.mesh_file.string())
-                                       : surface_interface(setup.mesh);
+  ExplicitSolver& solver = *setup.solver;
+  const SolidInterface interface =
+      setup.dimension == 2 ? strip_interface(setup.mesh, setup.strip_ties, setup.strip_depth, setup.mesh_file.string())
+      : setup.element_family == ElementFamily::hexahedron
+          ? brick_mid_surface_interface(setup.mesh, setup.mesh_file.string())
+          : surface_interface(setup.mesh);
 
   coupling::ParticipantOptions options;
   options.role = coupling::ParticipantRole::solid;
@@ -111,7 +112,7 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
                  participant->session().partner_solver_name, participant->session().partner_solver_version,
                  participant->session().scheme, omp_get_max_threads(), output_dir.string());
 
-    std::optional<ShellState> checkpoint;
+    std::optional<SolverState> checkpoint;
     Eigen::Matrix3Xd nodal_forces;
     coupling::Window window;
     bool have_unwritten_state = true;  // the initial state
@@ -135,7 +136,7 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
       const auto now = Clock::now();
       if (std::chrono::duration<double>(now - last_progress).count() >= c.solid().progress_interval_s()) {
         last_progress = now;
-        const ShellState& s = solver.state();
+        const SolverState& s = solver.state();
         spdlog::info("t = {:.5f} s, window {} (iteration {}), step {}, dt = {:.3g} s, energy error {:.2e}, wall {:.1f} s",
                      s.time, window.index, window.iteration, s.step, s.stable_step,
                      s.energy.relative_balance_error(),
@@ -143,7 +144,7 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
       }
     }
     output.accepted(solver, true);
-    const ShellState& s = solver.state();
+    const SolverState& s = solver.state();
     const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
     spdlog::info("done: t = {} s, {} steps, {} repeated windows, wall time {:.1f} s ({:.3g} ms per step), "
                  "energy balance error {:.2e}",

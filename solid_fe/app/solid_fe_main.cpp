@@ -33,15 +33,15 @@ int run_fe_only(const valvefsi::cases::Case& c, const std::filesystem::path& cas
   SolidSetup setup = setup_from_case(c, case_file);
   for (const auto& note : setup.notes) spdlog::info("{}", note);
   const valvefsi::PressureWaveform waveform(c.waveform(), case_file.string());
-  ShellSolver& solver = *setup.solver;
-  solver.set_pressure([&waveform](double t) { return waveform.transvalvular_pressure(t); }, setup.pressure_elements);
+  ExplicitSolver& solver = *setup.solver;
+  solver.set_pressure_waveform([&waveform](double t) { return waveform.transvalvular_pressure(t); });
 
   const double end_time = c.run().end_time();
   const double snapshot_interval = c.run().snapshot_interval();
   const double series_interval = c.run().series_interval();
   std::vector<std::pair<std::string, std::vector<std::int64_t>>> monitors;
   for (const auto& m : setup.monitors) monitors.emplace_back(m.name, m.nodes);
-  FieldWriter fields(output_dir, setup.mesh);
+  FieldWriter fields(output_dir, setup.mesh, setup.element_family);
   SeriesWriter series(output_dir, monitors);
   spdlog::info("FE-only: {} s of the waveform on {} threads, output to {}", end_time, omp_get_max_threads(),
                output_dir.string());
@@ -82,7 +82,7 @@ int run_fe_only(const valvefsi::cases::Case& c, const std::filesystem::path& cas
       if (std::chrono::duration<double>(now - last_progress).count() >= progress_interval || t >= end_time) {
         last_progress = now;
         const double wall = std::chrono::duration<double>(now - wall_start).count();
-        const ShellState& s = solver.state();
+        const SolverState& s = solver.state();
         spdlog::info("t = {:.5f} s ({:.1f} %), step {}, dt = {:.3g} s (element {}, calibration x{:.2f}), "
                      "energy error {:.2e}, wall {:.1f} s, left ~{:.0f} s",
                      t, 100 * t / end_time, s.step, s.stable_step, s.critical_element, s.step_calibration,
@@ -97,7 +97,7 @@ int run_fe_only(const valvefsi::cases::Case& c, const std::filesystem::path& cas
   }
   series.flush();
   const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
-  const ShellState& s = solver.state();
+  const SolverState& s = solver.state();
   spdlog::info("done: t = {} s, {} steps, wall time {:.1f} s ({:.3g} ms per step), energy balance error {:.2e}",
                s.time, s.step, wall, 1e3 * wall / std::max<std::int64_t>(s.step, 1),
                s.energy.relative_balance_error());

@@ -8,6 +8,8 @@
 #include <fmt/ranges.h>
 
 #include "valvefsi/case/case_loader.hpp"
+#include "valvefsi/solid/hexahedron_solver.hpp"
+#include "valvefsi/solid/shell_solver.hpp"
 
 namespace valvefsi::solid {
 
@@ -52,6 +54,26 @@ Material material_from_case(const cases::SolidCase& solid_in, const std::string&
   }
 }
 
+SolidMaterial solid_material_from_case(const cases::SolidCase& solid, const std::string& source) {
+  cases::SolidCase filled = solid;
+  filled.mutable_mhgo();
+  apply_field_limits(filled, source, "solid");
+  const double bulk_modulus = 2.0 / (filled.mhgo().d_per_kpa() * 1e-3);
+  return solid_material_from(material_from_case(solid, source), bulk_modulus);
+}
+
+ShellSolver& SolidSetup::shell_solver() const {
+  auto* s = dynamic_cast<ShellSolver*>(solver.get());
+  if (s == nullptr) throw std::logic_error("solid setup: the solver is not a shell solver");
+  return *s;
+}
+
+HexahedronSolver& SolidSetup::hexahedron_solver() const {
+  auto* s = dynamic_cast<HexahedronSolver*>(solver.get());
+  if (s == nullptr) throw std::logic_error("solid setup: the solver is not a hexahedron solver");
+  return *s;
+}
+
 namespace {
 
 const std::vector<std::int64_t>& node_set(const Mesh& mesh, const std::string& name, const std::string& field,
@@ -75,18 +97,25 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   }
   cases::SolidCase solid = c.solid();
   apply_field_limits(solid, source, "solid");
-  if (solid.element_family() != cases::SolidCase::SHELL) {
-    throw CaseError(fmt::format(
-        "{}: field 'solid.element_family' = HEXAHEDRON: not implemented yet; allowed: SHELL", source));
-  }
-
   SolidSetup setup;
   setup.mesh_file = resolve_case_path(case_file, solid.mesh_file());
   setup.mesh = read_mesh(setup.mesh_file);
   const Mesh& mesh = setup.mesh;
   const std::string mesh_name = setup.mesh_file.string();
-  if (mesh.triangles.empty()) {
+  const bool bricks = solid.element_family() == cases::SolidCase::HEXAHEDRON;
+  setup.element_family = bricks ? ElementFamily::hexahedron : ElementFamily::shell;
+  if (!bricks && mesh.triangles.empty()) {
     throw CaseError(fmt::format("{}: solid.element_family = SHELL but {} has no /mesh/triangles", source, mesh_name));
+  }
+  if (bricks && mesh.hexahedra.empty()) {
+    throw CaseError(fmt::format("{}: solid.element_family = HEXAHEDRON but {} has no /mesh/hexahedra "
+                                "(write it with scripts/valve_scene/generate.py --elements hexahedra)",
+                                source, mesh_name));
+  }
+  setup.dimension = c.run().has_dimension() ? c.run().dimension() : 3;
+  if (bricks && setup.dimension == 2) {
+    throw CaseError(fmt::format("{}: field 'run.dimension' = 2 with solid.element_family = HEXAHEDRON: 2D strips "
+                                "are shells; allowed: SHELL", source));
   }
 
   ShellModelOptions options;
@@ -103,13 +132,16 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   }
   options.fixed_nodes.assign(fixed.begin(), fixed.end());
 
+  const std::string element_type = bricks ? "hexahedron" : "triangle";
+  std::vector<std::int64_t> loaded;
   for (const auto& name : solid.pressure_element_sets()) {
     const auto it = mesh.element_sets.find(name);
-    if (it == mesh.element_sets.end() || mesh.element_set_types.at(name) != "triangle") {
-      throw CaseError(fmt::format("{}: field 'solid.pressure_element_sets' = \"{}\": no triangle element set "
-                                  "of that name in {}", source, name, mesh_name));
+    if (it == mesh.element_sets.end() || mesh.element_set_types.at(name) != element_type) {
+      throw CaseError(fmt::format("{}: field 'solid.pressure_element_sets' = \"{}\": no {} element set "
+                                  "of that name in {} (solid.element_family is {})", source, name, element_type,
+                                  mesh_name, bricks ? "HEXAHEDRON" : "SHELL"));
     }
-    setup.pressure_elements.insert(setup.pressure_elements.end(), it->second.begin(), it->second.end());
+    loaded.insert(loaded.end(), it->second.begin(), it->second.end());
   }
 
   std::vector<std::string> monitor_sets(solid.monitor_node_sets().begin(), solid.monitor_node_sets().end());
@@ -130,16 +162,36 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.max_time_step = solid.max_time_step();
   solver_options.contact_stiffness_factor = solid.contact_stiffness_factor();
 
-  Material material = material_from_case(solid, source);
-  setup.notes.push_back(fmt::format("mesh {}: {} nodes, {} triangles; material {}; {} fixed nodes ({}), {} edges",
-                                    mesh_name, mesh.num_nodes(), mesh.num_triangles(), material_name(material),
-                                    options.fixed_nodes.size(), fmt::join(fixed_sets, ", "),
-                                    options.clamp_fixed_edges ? "clamped" : "hinged"));
   if (solver_options.mass_damping_per_s > 0.0) {
     setup.notes.push_back(fmt::format("mass-proportional damping ON: alpha = {} 1/s", solver_options.mass_damping_per_s));
   }
-  setup.solver = std::make_unique<ShellSolver>(build_shell_model(mesh, options, mesh_name), std::move(material),
-                                               solver_options);
+  if (bricks) {
+    HexahedronModelOptions brick_options;
+    brick_options.density = options.density;
+    brick_options.fixed_nodes = options.fixed_nodes;
+    SolidMaterial material = solid_material_from_case(solid, source);
+    setup.pressure_faces = ventricular_faces(mesh, loaded);
+    setup.notes.push_back(fmt::format(
+        "mesh {}: {} nodes, {} hexahedra; material {} (3D, bulk modulus {:.4g} MPa); {} fixed nodes ({}); "
+        "{} pressure faces", mesh_name, mesh.num_nodes(), mesh.hexahedra.size(),
+        material_name(material_from_case(solid, source)), bulk_modulus(material) * 1e-6, options.fixed_nodes.size(),
+        fmt::join(fixed_sets, ", "), setup.pressure_faces.size()));
+    auto solver = std::make_unique<HexahedronSolver>(build_hexahedron_model(mesh, brick_options, mesh_name),
+                                                     std::move(material), solver_options);
+    solver->set_pressure({}, setup.pressure_faces);
+    setup.solver = std::move(solver);
+  } else {
+    setup.pressure_elements = loaded;
+    Material material = material_from_case(solid, source);
+    setup.notes.push_back(fmt::format("mesh {}: {} nodes, {} triangles; material {}; {} fixed nodes ({}), {} edges",
+                                      mesh_name, mesh.num_nodes(), mesh.num_triangles(), material_name(material),
+                                      options.fixed_nodes.size(), fmt::join(fixed_sets, ", "),
+                                      options.clamp_fixed_edges ? "clamped" : "hinged"));
+    auto solver = std::make_unique<ShellSolver>(build_shell_model(mesh, options, mesh_name), std::move(material),
+                                                solver_options);
+    solver->set_pressure({}, setup.pressure_elements);
+    setup.solver = std::move(solver);
+  }
 
   // Nodes on a mirror plane keep zero normal displacement.
   const double size = (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
@@ -154,7 +206,8 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
     setup.solver->add_symmetry_constraints(on_plane);
   }
   for (const auto& [name, plane] : mesh.contact_planes) {
-    setup.notes.push_back(fmt::format("contact plane '{}': penalty contact of the mid-surface offset by t/2", name));
+    setup.notes.push_back(fmt::format("contact plane '{}': penalty contact of {}", name,
+                                      bricks ? "the brick nodes" : "the mid-surface offset by t/2"));
     setup.solver->add_contact_plane(plane);
   }
   for (int k = 0; k < solid.contact_cylinders_size(); ++k) {
@@ -175,7 +228,6 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
                                       k, cylinder.radius, fmt::join(cyl.axis(), ", ")));
     setup.solver->add_contact_cylinder(cylinder);
   }
-  setup.dimension = c.run().has_dimension() ? c.run().dimension() : 3;
   setup.strip_depth = solid.strip_depth();
   if (setup.dimension == 2) {
     const auto& front = node_set(mesh, "strip_front", "run.dimension = 2 needs node set", source, mesh_name);
@@ -209,7 +261,10 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
       surface_of_node[static_cast<std::size_t>(n)] = leaflets;
     }
   }
-  if (solid.disable_leaflet_contact()) {
+  if (bricks) {
+    setup.notes.push_back(fmt::format("leaflet-leaflet contact: not available for bricks ({} leaflet node set(s))",
+                                      leaflets));
+  } else if (solid.disable_leaflet_contact()) {
     setup.notes.push_back("leaflet-leaflet contact OFF (solid.disable_leaflet_contact)");
   } else if (leaflets >= 2) {
     setup.notes.push_back(fmt::format("leaflet-leaflet contact between {} leaflets (node sets leaflet_k)", leaflets));

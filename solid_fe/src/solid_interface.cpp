@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include <Eigen/Geometry>
 #include <fmt/format.h>
 
 namespace valvefsi::solid {
@@ -41,20 +42,32 @@ void SolidInterface::nodal_forces(const Eigen::Matrix3Xd& interface_forces, std:
       f.z() = 0.0;
       out.col(nodes[k]) += f;
       out.col(partner[k]) += f;
+    } else if (mid_surface_pairs) {
+      // The mid-surface node moves as the pair's mean: half each keeps force and power equal.
+      const Eigen::Vector3d f = 0.5 * interface_forces.col(col);
+      out.col(nodes[k]) += f;
+      out.col(partner[k]) += f;
     } else {
       out.col(nodes[k]) += interface_forces.col(col);
     }
   }
 }
 
-void SolidInterface::motion(const ShellState& state, Eigen::Matrix3Xd& positions_out,
+void SolidInterface::motion(const SolverState& state, Eigen::Matrix3Xd& positions_out,
                             Eigen::Matrix3Xd& velocities_out) const {
   const auto n = static_cast<Eigen::Index>(nodes.size());
   positions_out.resize(3, n);
   velocities_out.resize(3, n);
   for (Eigen::Index k = 0; k < n; ++k) {
-    positions_out.col(k) = state.position.col(nodes[static_cast<std::size_t>(k)]);
-    velocities_out.col(k) = state.velocity.col(nodes[static_cast<std::size_t>(k)]);
+    const auto node = nodes[static_cast<std::size_t>(k)];
+    if (mid_surface_pairs) {
+      const auto other = partner[static_cast<std::size_t>(k)];
+      positions_out.col(k) = 0.5 * (state.position.col(node) + state.position.col(other));
+      velocities_out.col(k) = 0.5 * (state.velocity.col(node) + state.velocity.col(other));
+    } else {
+      positions_out.col(k) = state.position.col(node);
+      velocities_out.col(k) = state.velocity.col(node);
+    }
   }
   if (dimension == 2) {
     positions_out.row(2).setZero();
@@ -82,6 +95,65 @@ SolidInterface surface_interface(const Mesh& mesh) {
     }
   }
   s.node_thickness = node_thickness(mesh);
+  return s;
+}
+
+SolidInterface brick_mid_surface_interface(const Mesh& mesh, const std::string& source) {
+  SolidInterface s;
+  s.dimension = 3;
+  s.nodes_per_cell = 3;
+  s.mid_surface_pairs = true;
+  const auto num_nodes = static_cast<std::size_t>(mesh.num_nodes());
+  std::vector<std::int64_t> top_of(num_nodes, -1), index_of(num_nodes, -1);
+  std::vector<std::uint8_t> on_top(num_nodes, 0);
+  for (const auto& h : mesh.hexahedra) {
+    for (int a = 4; a < 8; ++a) on_top[static_cast<std::size_t>(h[a])] = 1;
+  }
+  for (std::size_t e = 0; e < mesh.hexahedra.size(); ++e) {
+    const auto& h = mesh.hexahedra[e];
+    for (int a = 0; a < 4; ++a) {
+      const auto bottom = static_cast<std::size_t>(h[a]);
+      if (on_top[bottom] || (top_of[bottom] >= 0 && top_of[bottom] != h[a + 4])) {
+        throw std::invalid_argument(fmt::format(
+            "{}: /mesh/hexahedra[{}]: node {} is {}; the coupled mid-surface needs leaflets one brick thick "
+            "(nodes 0-3 on the ventricular face, 4-7 above them on the aortic face)", source, e, h[a],
+            on_top[bottom] ? "on both faces" : fmt::format("paired with nodes {} and {}", top_of[bottom], h[a + 4])));
+      }
+      if (top_of[bottom] < 0) {
+        top_of[bottom] = h[a + 4];
+        index_of[bottom] = static_cast<std::int64_t>(s.nodes.size());
+        s.nodes.push_back(h[a]);
+        s.partner.push_back(h[a + 4]);
+      }
+    }
+  }
+  const auto n = static_cast<Eigen::Index>(s.nodes.size());
+  s.positions.resize(3, n);
+  s.node_thickness.resize(n);
+  s.node_areas = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const Eigen::Vector3d b = mesh.nodes.col(s.nodes[static_cast<std::size_t>(k)]);
+    const Eigen::Vector3d t = mesh.nodes.col(s.partner[static_cast<std::size_t>(k)]);
+    s.positions.col(k) = 0.5 * (b + t);
+    s.node_thickness(k) = (t - b).norm();
+  }
+  s.cells.resize(3, 2 * static_cast<Eigen::Index>(mesh.hexahedra.size()));
+  Eigen::Index cell = 0;
+  for (const auto& h : mesh.hexahedra) {
+    std::array<int, 4> q{};
+    for (int a = 0; a < 4; ++a) q[static_cast<std::size_t>(a)] = static_cast<int>(index_of[static_cast<std::size_t>(h[a])]);
+    // 0-1-2-3 runs counter-clockwise seen from the outflow side: the triangles' normals point there.
+    for (const auto& tri : {std::array<int, 3>{q[0], q[1], q[2]}, std::array<int, 3>{q[0], q[2], q[3]}}) {
+      const double area = 0.5 * (s.positions.col(tri[1]) - s.positions.col(tri[0]))
+                                    .cross(s.positions.col(tri[2]) - s.positions.col(tri[0]))
+                                    .norm();
+      for (int a = 0; a < 3; ++a) {
+        s.cells(a, cell) = tri[static_cast<std::size_t>(a)];
+        s.node_areas(tri[static_cast<std::size_t>(a)]) += area / 3.0;
+      }
+      ++cell;
+    }
+  }
   return s;
 }
 

@@ -30,22 +30,27 @@ void write_scalar_attribute(hid_t object, const char* name, double value) {
 
 }  // namespace
 
-FieldWriter::FieldWriter(const std::filesystem::path& dir, const Mesh& mesh)
-    : dir_(dir), num_nodes_(mesh.num_nodes()), num_triangles_(mesh.num_triangles()) {
+FieldWriter::FieldWriter(const std::filesystem::path& dir, const Mesh& mesh, ElementFamily family)
+    : dir_(dir), family_(family), num_nodes_(mesh.num_nodes()),
+      num_elements_(family == ElementFamily::shell ? mesh.num_triangles()
+                                                   : static_cast<std::int64_t>(mesh.hexahedra.size())) {
   std::filesystem::create_directories(dir_);
   const auto path = dir_ / "solid_fields.h5";
   file_ = H5Handle(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
   if (!file_.valid()) throw std::runtime_error(path.string() + ": cannot create output file");
   write_array(file_.get(), "/mesh/nodes", mesh.nodes.data(), static_cast<hsize_t>(num_nodes_), 3);
-  const hsize_t dims[2] = {static_cast<hsize_t>(num_triangles_), 3};
+  const bool shell = family_ == ElementFamily::shell;
+  const hsize_t dims[2] = {static_cast<hsize_t>(num_elements_), shell ? 3u : 8u};
   H5Handle space(H5Screate_simple(2, dims, nullptr), H5Sclose);
-  H5Handle ds(H5Dcreate2(file_.get(), "/mesh/triangles", H5T_NATIVE_INT64, space.get(), H5P_DEFAULT, H5P_DEFAULT,
-                         H5P_DEFAULT), H5Dclose);
-  H5Dwrite(ds.get(), H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, mesh.triangles.data());
+  H5Handle ds(H5Dcreate2(file_.get(), shell ? "/mesh/triangles" : "/mesh/hexahedra", H5T_NATIVE_INT64, space.get(),
+                         H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
+  // Hexahedron node order 0-3 / 4-7 is XDMF's (and VTK's) Hexahedron order.
+  H5Dwrite(ds.get(), H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+           shell ? static_cast<const void*>(mesh.triangles.data()) : static_cast<const void*>(mesh.hexahedra.data()));
 }
 
-void FieldWriter::write(const ShellSolver& solver, double& peak_stress, double& peak_log_strain) {
-  const ShellState& s = solver.state();
+void FieldWriter::write(const ExplicitSolver& solver, double& peak_stress, double& peak_log_strain) {
+  const SolverState& s = solver.state();
   const std::string group = fmt::format("/snapshots/{:06d}", times_.size());
   const auto n = static_cast<hsize_t>(num_nodes_);
   const Eigen::Matrix3Xd u = solver.displacement();
@@ -54,7 +59,7 @@ void FieldWriter::write(const ShellSolver& solver, double& peak_stress, double& 
   write_array(file_.get(), group + "/velocity", s.velocity.data(), n, 3);
   Eigen::VectorXd stress, strain;
   solver.element_fields(stress, strain);
-  const auto t = static_cast<hsize_t>(num_triangles_);
+  const auto t = static_cast<hsize_t>(num_elements_);
   write_array(file_.get(), group + "/max_principal_stress", stress.data(), t, 0);
   write_array(file_.get(), group + "/max_principal_log_strain", strain.data(), t, 0);
   {
@@ -75,6 +80,7 @@ void FieldWriter::write_xdmf() const {
     std::ofstream out(tmp);
     out << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
         << "  <Grid Name=\"leaflets\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+    const bool shell = family_ == ElementFamily::shell;
     for (std::size_t k = 0; k < times_.size(); ++k) {
       const std::string g = fmt::format("solid_fields.h5:/snapshots/{:06d}", k);
       const auto vec = [&](const char* name, const char* center) {
@@ -87,13 +93,14 @@ void FieldWriter::write_xdmf() const {
         return fmt::format(
             "    <Attribute Name=\"{0}\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
             "     <DataItem Dimensions=\"{1}\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{2}/{0}</DataItem>\n"
-            "    </Attribute>\n", name, num_triangles_, g);
+            "    </Attribute>\n", name, num_elements_, g);
       };
       out << fmt::format("   <Grid Name=\"t{}\" GridType=\"Uniform\">\n    <Time Value=\"{:.9g}\"/>\n", k, times_[k])
-          << fmt::format("    <Topology TopologyType=\"Triangle\" NumberOfElements=\"{}\">\n"
-                         "     <DataItem Dimensions=\"{} 3\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">"
-                         "solid_fields.h5:/mesh/triangles</DataItem>\n    </Topology>\n",
-                         num_triangles_, num_triangles_)
+          << fmt::format("    <Topology TopologyType=\"{0}\" NumberOfElements=\"{1}\">\n"
+                         "     <DataItem Dimensions=\"{1} {2}\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">"
+                         "solid_fields.h5:/mesh/{3}</DataItem>\n    </Topology>\n",
+                         shell ? "Triangle" : "Hexahedron", num_elements_, shell ? 3 : 8,
+                         shell ? "triangles" : "hexahedra")
           << fmt::format("    <Geometry GeometryType=\"XYZ\">\n"
                          "     <DataItem Dimensions=\"{} 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">"
                          "{}/position</DataItem>\n    </Geometry>\n", num_nodes_, g)
@@ -111,8 +118,8 @@ SeriesWriter::SeriesWriter(std::filesystem::path dir,
   std::filesystem::create_directories(dir_);
 }
 
-void SeriesWriter::sample(const ShellSolver& solver, double pressure_Pa) {
-  const ShellState& s = solver.state();
+void SeriesWriter::sample(const ExplicitSolver& solver, double pressure_Pa) {
+  const SolverState& s = solver.state();
   const EnergyBalance& e = s.energy;
   columns_["time"].push_back(s.time);
   columns_["step"].push_back(static_cast<double>(s.step));
@@ -124,6 +131,10 @@ void SeriesWriter::sample(const ShellSolver& solver, double pressure_Pa) {
   columns_["energy/external_work"].push_back(e.external_work);
   columns_["energy/damping_work"].push_back(e.damping_work);
   columns_["energy/contact_work"].push_back(e.contact_work);
+  if (s.hourglass_force.cols() > 0) {  // bricks: bending lives in the hourglass modes
+    columns_["energy/hourglass_work"].push_back(e.hourglass_work);
+    columns_["energy/hourglass_energy"].push_back(e.hourglass_energy);
+  }
   columns_["energy/balance"].push_back(e.balance());
   columns_["energy/relative_balance_error"].push_back(e.relative_balance_error());
   for (std::size_t m = 0; m < monitors_.size(); ++m) {

@@ -8,6 +8,7 @@
 #include "test_meshes.hpp"
 #include "valvefsi/case/case_loader.hpp"
 #include "valvefsi/solid/case_setup.hpp"
+#include "valvefsi/solid/shell_solver.hpp"
 #include "valvefsi/solid/solid_output.hpp"
 
 namespace valvefsi::solid {
@@ -39,12 +40,13 @@ TEST(CaseSetup, BuildsTheSolverFromTheCase) {
   const CaseFiles f = write_case("ok", "material: OGDEN");
   const cases::Case c = load_case(f.case_file);
   const SolidSetup setup = setup_from_case(c, f.case_file);
-  EXPECT_TRUE(std::holds_alternative<Ogden>(setup.solver->material()));
-  EXPECT_NEAR(std::get<Ogden>(setup.solver->material()).parameters().mu_Pa[1], 260.56e3, 1e-6);
+  const ShellSolver& solver = setup.shell_solver();
+  EXPECT_TRUE(std::holds_alternative<Ogden>(solver.material()));
+  EXPECT_NEAR(std::get<Ogden>(solver.material()).parameters().mu_Pa[1], 260.56e3, 1e-6);
   EXPECT_EQ(setup.monitors.size(), 1u);
   EXPECT_EQ(setup.monitors[0].name, "free_edge_midpoints");
   int fixed = 0;
-  for (auto v : setup.solver->model().fixed) fixed += v;
+  for (auto v : solver.model().fixed) fixed += v;
   EXPECT_EQ(fixed, 5);
 }
 
@@ -66,7 +68,7 @@ TEST(CaseSetup, FeOnlyRunWritesFieldsAndSeries) {
   const CaseFiles f = write_case("run", "material: NEO_HOOKEAN neo_hookean { shear_modulus_kPa: 200 }");
   const cases::Case c = load_case(f.case_file);
   SolidSetup setup = setup_from_case(c, f.case_file);
-  ShellSolver& solver = *setup.solver;
+  ShellSolver& solver = setup.shell_solver();
   const double dp = 10 * 133.322387415;
   solver.set_pressure([dp](double) { return dp; });
   FieldWriter fields(f.dir / "out", setup.mesh);

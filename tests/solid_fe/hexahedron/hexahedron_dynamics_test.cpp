@@ -9,6 +9,7 @@
 #include "../test_meshes.hpp"
 #include "hex_test_meshes.hpp"
 #include "valvefsi/solid/hexahedron_solver.hpp"
+#include "valvefsi/solid/shell_solver.hpp"
 
 namespace valvefsi::solid {
 namespace {

@@ -7,7 +7,8 @@
 
 #include "hex_test_meshes.hpp"
 #include "valvefsi/case/case_loader.hpp"
-#include "valvefsi/solid/hexahedron_setup.hpp"
+#include "valvefsi/solid/case_setup.hpp"
+#include "valvefsi/solid/hexahedron_solver.hpp"
 
 namespace valvefsi::solid {
 namespace {
@@ -43,35 +44,36 @@ std::filesystem::path write_case(const std::string& name, const std::string& sol
 
 TEST(HexahedronSetup, BuildsTheSolverFromTheCase) {
   const auto file = write_case("ok", "material: OGDEN mhgo { d_per_kPa: 2e-5 }");
-  const HexahedronSetup setup = hexahedron_setup_from_case(load_case(file), file);
-  ASSERT_TRUE(std::holds_alternative<SolidOgden>(setup.solver->material()));
-  EXPECT_NEAR(bulk_modulus(setup.solver->material()), 2.0 / 2e-8, 1.0);  // kappa = 2 / D
+  const SolidSetup setup = setup_from_case(load_case(file), file);
+  ASSERT_EQ(setup.element_family, ElementFamily::hexahedron);
+  HexahedronSolver& solver = setup.hexahedron_solver();
+  ASSERT_TRUE(std::holds_alternative<SolidOgden>(solver.material()));
+  EXPECT_NEAR(bulk_modulus(solver.material()), 2.0 / 2e-8, 1.0);  // kappa = 2 / D
   EXPECT_EQ(setup.pressure_faces.size(), 32u);                          // every bottom face
   int fixed = 0;
-  for (auto v : setup.solver->model().fixed) fixed += v;
+  for (auto v : solver.model().fixed) fixed += v;
   EXPECT_EQ(fixed, 10);  // x = 0 face: 5 x 2 nodes
   // The nodes on the y = 0 mirror plane keep y = 0 under a pull along y.
-  HexahedronSolver& solver = *setup.solver;
   Eigen::Matrix3Xd pull = Eigen::Matrix3Xd::Zero(3, setup.mesh.num_nodes());
   pull.row(1).setConstant(-1e-3);
   solver.advance_window(1e-5, &pull);
   for (const auto n : setup.mesh.node_sets.at("y0")) EXPECT_EQ(solver.displacement()(1, n), 0.0);
 
   const auto only_set = write_case("set", "pressure_element_sets: \"leaflet_0_hexahedra\"");
-  EXPECT_EQ(hexahedron_setup_from_case(load_case(only_set), only_set).pressure_faces.size(), 4u);
+  EXPECT_EQ(setup_from_case(load_case(only_set), only_set).pressure_faces.size(), 4u);
 }
 
 TEST(HexahedronSetup, MessagesNameTheField) {
   const auto bad_set = write_case("badset", "pressure_element_sets: \"nope\"");
   try {
-    hexahedron_setup_from_case(load_case(bad_set), bad_set);
+    setup_from_case(load_case(bad_set), bad_set);
     FAIL();
   } catch (const CaseError& e) {
     EXPECT_NE(std::string(e.what()).find("solid.pressure_element_sets"), std::string::npos) << e.what();
   }
   const auto no_bricks = write_case("nobricks", "", false);
   try {
-    hexahedron_setup_from_case(load_case(no_bricks), no_bricks);
+    setup_from_case(load_case(no_bricks), no_bricks);
     FAIL();
   } catch (const CaseError& e) {
     EXPECT_NE(std::string(e.what()).find("/mesh/hexahedra"), std::string::npos) << e.what();

@@ -15,7 +15,8 @@
 #include "valvefsi/case/case_loader.hpp"
 #include "valvefsi/case/pressure_waveform.hpp"
 #include "valvefsi/solid/case_setup.hpp"
-#include "valvefsi/solid/hexahedron_setup.hpp"
+#include "valvefsi/solid/hexahedron_solver.hpp"
+#include "valvefsi/solid/shell_solver.hpp"
 
 namespace valvefsi::solid {
 namespace {
@@ -82,14 +83,14 @@ TEST(HexahedronValve, SectorOpensLikeTheShell) {
   cases::Case brick_case = c;
   brick_case.mutable_solid()->set_mesh_file(std::filesystem::absolute(mesh_env).string());
   brick_case.mutable_solid()->set_element_family(cases::SolidCase::HEXAHEDRON);
-  HexahedronSetup bricks = hexahedron_setup_from_case(brick_case, case_file);
+  SolidSetup bricks = setup_from_case(brick_case, case_file);
   for (const auto& note : bricks.notes) std::printf("bricks: %s\n", note.c_str());
-  bricks.solver->set_pressure(pressure, bricks.pressure_faces);
-  const RunSummary b = run(*bricks.solver, bricks.mesh.node_sets.at("free_edge"), end_time, "bricks");
+  bricks.solver->set_pressure_waveform(pressure);
+  const RunSummary b = run(bricks.hexahedron_solver(), bricks.mesh.node_sets.at("free_edge"), end_time, "bricks");
 
   SolidSetup shells = setup_from_case(c, case_file);
-  shells.solver->set_pressure(pressure, shells.pressure_elements);
-  const RunSummary s = run(*shells.solver, shells.mesh.node_sets.at("free_edge"), end_time, "shell");
+  shells.solver->set_pressure_waveform(pressure);
+  const RunSummary s = run(shells.shell_solver(), shells.mesh.node_sets.at("free_edge"), end_time, "shell");
 
   for (const auto& [name, r, elements] : {std::tuple{"bricks", b, bricks.mesh.hexahedra.size()},
                                           std::tuple{"shell", s, shells.mesh.triangles.size()}}) {

@@ -10,16 +10,17 @@
 
 #include "valvefsi/solid/hdf5_handle.hpp"
 #include "valvefsi/solid/mesh.hpp"
-#include "valvefsi/solid/shell_solver.hpp"
+#include "valvefsi/solid/explicit_solver.hpp"
 
 namespace valvefsi::solid {
 
-// <dir>/solid_fields.h5 and <dir>/solid_fields.xdmf.
+// <dir>/solid_fields.h5 and <dir>/solid_fields.xdmf: the mesh's triangles (shells) or
+// hexahedra (bricks), node fields and one value per element.
 class FieldWriter {
  public:
-  FieldWriter(const std::filesystem::path& dir, const Mesh& mesh);
+  FieldWriter(const std::filesystem::path& dir, const Mesh& mesh, ElementFamily family = ElementFamily::shell);
   // Writes positions, displacement, velocity and the element fields of the solver's state.
-  void write(const ShellSolver& solver, double& peak_stress, double& peak_log_strain);
+  void write(const ExplicitSolver& solver, double& peak_stress, double& peak_log_strain);
   int count() const { return static_cast<int>(times_.size()); }
 
  private:
@@ -27,7 +28,8 @@ class FieldWriter {
 
   std::filesystem::path dir_;
   H5Handle file_;
-  std::int64_t num_nodes_, num_triangles_;
+  ElementFamily family_;
+  std::int64_t num_nodes_, num_elements_;
   std::vector<double> times_;
 };
 
@@ -35,7 +37,7 @@ class FieldWriter {
 class SeriesWriter {
  public:
   SeriesWriter(std::filesystem::path dir, std::vector<std::pair<std::string, std::vector<std::int64_t>>> monitors);
-  void sample(const ShellSolver& solver, double pressure_Pa);
+  void sample(const ExplicitSolver& solver, double pressure_Pa);
   void add_snapshot_peaks(double time, double peak_stress, double peak_log_strain);
   void flush() const;
 

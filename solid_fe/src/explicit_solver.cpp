@@ -1,4 +1,4 @@
-#include "valvefsi/solid/shell_solver.hpp"
+#include "valvefsi/solid/explicit_solver.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,16 +8,10 @@
 
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
-#include <omp.h>
 
 #include "valvefsi/solid/material_error.hpp"
-#include "valvefsi/solid/shell_forces.hpp"
 
 namespace valvefsi::solid {
-namespace {
-constexpr std::int64_t kMinElementsForThreads = 1000;
-}  // namespace
-
 double EnergyBalance::relative_balance_error() const {
   const double scale = std::max({std::abs(kinetic), std::abs(internal_work), std::abs(external_work),
                                  std::abs(damping_work), std::abs(contact_work), std::abs(initial_kinetic),
@@ -25,8 +19,9 @@ double EnergyBalance::relative_balance_error() const {
   return std::abs(balance()) / scale;
 }
 
-ShellSolver::ShellSolver(ShellModel model, Material material, SolverOptions options)
-    : model_(std::move(model)), material_(std::move(material)), options_(options) {
+ExplicitSolver::ExplicitSolver(std::unique_ptr<ElementModel> elements, SolverOptions options)
+    : elements_(std::move(elements)), options_(options) {
+  if (!elements_) throw std::invalid_argument("solid: no element model");
   if (!(options_.time_step_safety > 0.0 && options_.time_step_safety <= 1.0)) {
     throw std::invalid_argument(fmt::format(
         "solid: time_step_safety = {}: allowed (0, 1]", options_.time_step_safety));
@@ -35,55 +30,47 @@ ShellSolver::ShellSolver(ShellModel model, Material material, SolverOptions opti
     throw std::invalid_argument(fmt::format(
         "solid: time_step_update_interval = {}: allowed >= 1", options_.time_step_update_interval));
   }
-  const Eigen::Index n = model_.reference_positions.cols();
-  state_.position = model_.reference_positions;
-  state_.half_step_velocity = Eigen::Matrix3Xd::Zero(3, n);
-  state_.velocity = Eigen::Matrix3Xd::Zero(3, n);
-  state_.internal_force = Eigen::Matrix3Xd::Zero(3, n);
-  state_.external_force = Eigen::Matrix3Xd::Zero(3, n);
-  state_.contact_force = Eigen::Matrix3Xd::Zero(3, n);
-  half_thickness_ = Eigen::VectorXd::Zero(n);
-  for (const auto& el : model_.elements) {
-    for (const auto a : el.nodes) half_thickness_(a) = std::max(half_thickness_(a), 0.5 * el.thickness);
-  }
-  acceleration_ = Eigen::Matrix3Xd::Zero(3, n);
+  const Eigen::Index n = elements_->reference_positions().cols();
   for (Eigen::Index i = 0; i < n; ++i) {
-    if (!(model_.nodal_mass(i) > 0.0)) {
-      throw std::invalid_argument(fmt::format("solid: node {} belongs to no element (zero mass)", i));
+    if (!(elements_->nodal_mass()(i) > 0.0)) {
+      throw std::invalid_argument(fmt::format("solid: node {} belongs to no {} element (zero mass)", i,
+                                              elements_->family()));
     }
   }
+  state_.position = elements_->reference_positions();
+  for (Eigen::Matrix3Xd* m : {&state_.half_step_velocity, &state_.velocity, &state_.internal_force,
+                              &state_.external_force, &state_.contact_force, &acceleration_}) {
+    *m = Eigen::Matrix3Xd::Zero(3, n);
+  }
+  if (elements_->has_hourglass_forces()) state_.hourglass_force = Eigen::Matrix3Xd::Zero(3, n);
+  half_thickness_ = elements_->contact_half_thickness();
 }
 
-void ShellSolver::set_pressure(std::function<double(double)> pressure_Pa, std::vector<std::int64_t> elements) {
+void ExplicitSolver::set_pressure_waveform(std::function<double(double)> pressure_Pa) {
   pressure_ = std::move(pressure_Pa);
-  if (elements.empty()) {
-    elements.resize(model_.elements.size());
-    for (std::size_t e = 0; e < elements.size(); ++e) elements[e] = static_cast<std::int64_t>(e);
-  }
-  for (const std::int64_t e : elements) {
-    if (e < 0 || e >= static_cast<std::int64_t>(model_.elements.size())) {
-      throw std::invalid_argument(fmt::format("solid: pressure element {} does not exist", e));
-    }
-  }
-  pressure_elements_ = std::move(elements);
   internal_force_current_ = false;
 }
 
-void ShellSolver::add_symmetry_constraints(const std::vector<SymmetryConstraint>& constraints) {
+void ExplicitSolver::add_symmetry_constraints(const std::vector<SymmetryConstraint>& constraints) {
   for (const auto& c : constraints) symmetry_.push_back({c.node, c.normal.normalized()});
 }
 
-void ShellSolver::add_contact_plane(const Plane& plane) {
+void ExplicitSolver::add_contact_plane(const Plane& plane) {
   contact_planes_.push_back({plane.point, plane.normal.normalized()});
   internal_force_current_ = false;
 }
 
-void ShellSolver::enable_leaflet_contact(std::vector<int> surface_of_node) {
-  leaflet_contact_.emplace(model_, std::move(surface_of_node));
+void ExplicitSolver::enable_leaflet_contact(std::vector<int> surface_of_node) {
+  const ShellModel* surface = elements_->contact_surface();
+  if (surface == nullptr) {
+    throw std::invalid_argument(fmt::format("solid: leaflet-leaflet contact needs shell elements, not {}",
+                                            elements_->family()));
+  }
+  leaflet_contact_.emplace(*surface, std::move(surface_of_node));
   internal_force_current_ = false;
 }
 
-void ShellSolver::add_contact_cylinder(const ContactCylinder& cylinder) {
+void ExplicitSolver::add_contact_cylinder(const ContactCylinder& cylinder) {
   if (!(cylinder.radius > 0.0) || !(cylinder.axis.norm() > 0.0)) {
     throw std::invalid_argument(fmt::format("solid: contact cylinder radius {} m, axis norm {}: allowed > 0",
                                             cylinder.radius, cylinder.axis.norm()));
@@ -92,8 +79,8 @@ void ShellSolver::add_contact_cylinder(const ContactCylinder& cylinder) {
   internal_force_current_ = false;
 }
 
-void ShellSolver::set_strip_ties(std::vector<StripTie> ties) {
-  const Eigen::Index n = model_.reference_positions.cols();
+void ExplicitSolver::set_strip_ties(std::vector<StripTie> ties) {
+  const Eigen::Index n = elements_->reference_positions().cols();
   for (const auto& t : ties) {
     if (t.front < 0 || t.front >= n || t.back < 0 || t.back >= n || t.front == t.back) {
       throw std::invalid_argument(fmt::format("solid: strip tie ({}, {}): nodes must differ and exist (mesh has {})",
@@ -107,7 +94,7 @@ void ShellSolver::set_strip_ties(std::vector<StripTie> ties) {
   internal_force_current_ = false;
 }
 
-void ShellSolver::compute_contact_force() {
+void ExplicitSolver::compute_contact_force() {
   Eigen::Matrix3Xd& f = state_.contact_force;
   f.setZero();
   state_.nodes_in_contact = 0;
@@ -115,40 +102,43 @@ void ShellSolver::compute_contact_force() {
   // Penalty stiffness from the highest frequency the first step resolves, k = factor m (2/dt)^2,
   // then kept: a constant spring is conservative, and the step only shrinks as tissue stiffens.
   if (contact_omega2_ == 0.0) {
-    const double dt_critical = state_.stable_step / options_.time_step_safety;
+    const double dt_critical =
+        state_.stable_step / (step_factor_ > 0.0 ? step_factor_ : options_.time_step_safety);
     contact_omega2_ = 4.0 / (dt_critical * dt_critical);
   }
   const double omega2 = contact_omega2_;
   const Eigen::Matrix3Xd& x = state_.position;
+  const auto& fixed = elements_->fixed();
+  const Eigen::VectorXd& mass = elements_->nodal_mass();
   for (const Plane& plane : contact_planes_) {
     for (Eigen::Index i = 0; i < x.cols(); ++i) {
       const double gap = (x.col(i) - plane.point).dot(plane.normal) - half_thickness_(i);
-      if (gap < 0.0 && !model_.fixed[static_cast<std::size_t>(i)]) {
-        f.col(i) -= options_.contact_stiffness_factor * model_.nodal_mass(i) * omega2 * gap * plane.normal;
+      if (gap < 0.0 && !fixed[static_cast<std::size_t>(i)]) {
+        f.col(i) -= options_.contact_stiffness_factor * mass(i) * omega2 * gap * plane.normal;
         ++state_.nodes_in_contact;
       }
     }
   }
   for (const ContactCylinder& cylinder : contact_cylinders_) {
     for (Eigen::Index i = 0; i < x.cols(); ++i) {
-      if (model_.fixed[static_cast<std::size_t>(i)]) continue;
+      if (fixed[static_cast<std::size_t>(i)]) continue;
       const Eigen::Vector3d d = x.col(i) - cylinder.origin;
       const Eigen::Vector3d radial = d - d.dot(cylinder.axis) * cylinder.axis;
       const double r = radial.norm();
       const double penetration = r + half_thickness_(i) - cylinder.radius;
       if (penetration > 0.0 && r > 0.0) {
-        f.col(i) -= options_.contact_stiffness_factor * model_.nodal_mass(i) * omega2 * penetration * (radial / r);
+        f.col(i) -= options_.contact_stiffness_factor * mass(i) * omega2 * penetration * (radial / r);
         ++state_.nodes_in_contact;
       }
     }
   }
   if (leaflet_contact_) {
     state_.nodes_in_contact +=
-        leaflet_contact_->add_forces(model_, x, options_.contact_stiffness_factor * omega2, f);
+        leaflet_contact_->add_forces(*elements_->contact_surface(), x, options_.contact_stiffness_factor * omega2, f);
   }
 }
 
-void ShellSolver::set_velocity(const Eigen::Matrix3Xd& velocity) {
+void ExplicitSolver::set_velocity(const Eigen::Matrix3Xd& velocity) {
   state_.velocity = velocity;
   state_.half_step_velocity = velocity;
   apply_constraints(state_.velocity);
@@ -156,11 +146,11 @@ void ShellSolver::set_velocity(const Eigen::Matrix3Xd& velocity) {
   internal_force_current_ = false;
 }
 
-void ShellSolver::apply_constraints(Eigen::Matrix3Xd& field) const {
+void ExplicitSolver::apply_constraints(Eigen::Matrix3Xd& field) const {
   if (planar_) {
     field.row(2).setZero();
     for (const auto& t : ties_) {
-      const double ma = model_.nodal_mass(t.front), mb = model_.nodal_mass(t.back);
+      const double ma = elements_->nodal_mass()(t.front), mb = elements_->nodal_mass()(t.back);
       const Eigen::Vector3d mean = (ma * field.col(t.front) + mb * field.col(t.back)) / (ma + mb);
       field.col(t.front) = mean;
       field.col(t.back) = mean;
@@ -170,73 +160,29 @@ void ShellSolver::apply_constraints(Eigen::Matrix3Xd& field) const {
     auto col = field.col(c.node);
     col -= col.dot(c.normal) * c.normal;
   }
-  for (std::size_t i = 0; i < model_.fixed.size(); ++i) {
-    if (model_.fixed[i]) field.col(static_cast<Eigen::Index>(i)).setZero();
+  const auto& fixed = elements_->fixed();
+  for (std::size_t i = 0; i < fixed.size(); ++i) {
+    if (fixed[i]) field.col(static_cast<Eigen::Index>(i)).setZero();
   }
 }
 
-double ShellSolver::evaluate_internal_force(const Eigen::Matrix3Xd& x, bool estimate_step, Eigen::Matrix3Xd& out,
-                                            double& min_step, std::int64_t& critical) {
-  const int threads = omp_get_max_threads();
-  const Eigen::Index n = model_.reference_positions.cols();
-  if (static_cast<int>(thread_forces_.size()) != threads) {
-    thread_forces_.assign(static_cast<std::size_t>(threads), Eigen::Matrix3Xd::Zero(3, n));
+InternalForceResult ExplicitSolver::evaluate_internal_force(const Eigen::Matrix3Xd& x, bool estimate_step,
+                                                             Eigen::Matrix3Xd& out, Eigen::Matrix3Xd* hourglass) {
+  try {
+    return elements_->internal_force(x, estimate_step, out, hourglass);
+  } catch (const MaterialStateError& ex) {
+    throw MaterialStateError(fmt::format("solid at t = {:.6g} s, step {}: {}", state_.time, state_.step, ex.what()));
   }
-  const auto num_elements = static_cast<std::int64_t>(model_.elements.size());
-  double strain_energy = 0.0;
-  min_step = std::numeric_limits<double>::infinity();
-  critical = -1;
-  std::string error;
-  std::visit(
-      [&](const auto& law) {
-        // Small models run serially: thread start-up would cost more than it saves.
-#pragma omp parallel if (num_elements >= kMinElementsForThreads)
-        {
-          Eigen::Matrix3Xd& f = thread_forces_[static_cast<std::size_t>(omp_get_thread_num())];
-          f.setZero();
-          double local_energy = 0.0;
-          double local_step = std::numeric_limits<double>::infinity();
-          std::int64_t local_critical = -1;
-#pragma omp for schedule(static)
-          for (std::int64_t e = 0; e < num_elements; ++e) {
-            try {
-              const ElementResult r = add_element_internal_force(
-                  model_, model_.elements[static_cast<std::size_t>(e)], law, x, f, estimate_step);
-              local_energy += r.strain_energy;
-              if (r.stable_step < local_step) {
-                local_step = r.stable_step;
-                local_critical = e;
-              }
-            } catch (const MaterialStateError& ex) {
-#pragma omp critical(valvefsi_solid_error)
-              if (error.empty()) error = fmt::format("element {}: {}", e, ex.what());
-            }
-          }
-#pragma omp critical(valvefsi_solid_reduce)
-          {
-            strain_energy += local_energy;
-            if (local_step < min_step) {
-              min_step = local_step;
-              critical = local_critical;
-            }
-          }
-        }
-      },
-      material_);
-  if (!error.empty()) {
-    throw MaterialStateError(fmt::format("solid at t = {:.6g} s, step {}: {}", state_.time, state_.step, error));
-  }
-  if (out.cols() != n) out.resize(3, n);
-  out = thread_forces_[0];
-  for (std::size_t t = 1; t < thread_forces_.size(); ++t) out += thread_forces_[t];
-  return strain_energy;
 }
 
-void ShellSolver::compute_internal_force(bool estimate_step) {
-  double min_step = 0;
-  std::int64_t critical = -1;
-  state_.energy.strain_energy =
-      evaluate_internal_force(state_.position, estimate_step, state_.internal_force, min_step, critical);
+void ExplicitSolver::compute_internal_force(bool estimate_step) {
+  const InternalForceResult r =
+      evaluate_internal_force(state_.position, estimate_step, state_.internal_force,
+                              elements_->has_hourglass_forces() ? &state_.hourglass_force : nullptr);
+  state_.energy.strain_energy = r.strain_energy;
+  state_.energy.hourglass_energy = r.hourglass_energy;
+  const double min_step = r.min_step;
+  const std::int64_t critical = r.critical_element;
   if (options_.fixed_time_step > 0.0) {
     state_.stable_step = options_.fixed_time_step;
   } else if (estimate_step) {
@@ -257,18 +203,19 @@ void ShellSolver::compute_internal_force(bool estimate_step) {
       }
       state_.step_calibration = critical_step / min_step;
     }
-    state_.stable_step = std::min(options_.time_step_safety * critical_step, options_.max_time_step);
+    const double safety = step_factor_ > 0.0 ? step_factor_ : options_.time_step_safety;
+    state_.stable_step = std::min(safety * critical_step, options_.max_time_step);
     state_.critical_element = critical;
   }
   internal_force_current_ = true;
 }
 
-void ShellSolver::calibrate_stable_step(double element_step) {
+void ExplicitSolver::calibrate_stable_step(double element_step) {
   // Lanczos on M^-1 K in the mass inner product (symmetric there), K q by a forward difference
   // of the internal force, full re-orthogonalisation (few vectors). The largest Ritz value plus
   // its residual bound beta_k |s_k| estimates omega_max^2 from slightly above; a plain power
   // iteration converges too slowly on the valve's clustered top spectrum (several slivers).
-  const Eigen::Index n = model_.reference_positions.cols();
+  const Eigen::Index n = elements_->reference_positions().cols();
   // Deterministic pseudo-random vectors (xorshift seeded by the step), so a restored state
   // repeats exactly the same calibration.
   const auto random_matrix = [n](std::uint64_t seed) {
@@ -284,12 +231,12 @@ void ShellSolver::calibrate_stable_step(double element_step) {
   };
   Eigen::Matrix3Xd& v = state_.power_vector;
   if (v.cols() != n) v = random_matrix(0);
-  const Eigen::ArrayXd mass = model_.nodal_mass.array();
+  const Eigen::ArrayXd mass = elements_->nodal_mass().array();
   const auto m_dot = [&](const Eigen::Matrix3Xd& p, const Eigen::Matrix3Xd& q) {
     return ((p.cwiseProduct(q)).colwise().sum().transpose().array() * mass).sum();
   };
-  const double size = (model_.reference_positions.rowwise().maxCoeff() -
-                       model_.reference_positions.rowwise().minCoeff()).norm();
+  const Eigen::Matrix3Xd& reference = elements_->reference_positions();
+  const double size = (reference.rowwise().maxCoeff() - reference.rowwise().minCoeff()).norm();
   const int k_max = std::max(2, options_.power_iterations);
   lanczos_basis_.resize(static_cast<std::size_t>(k_max + 1));
   std::vector<double> alpha, beta;
@@ -301,8 +248,6 @@ void ShellSolver::calibrate_stable_step(double element_step) {
   double norm = std::sqrt(m_dot(q0, q0));
   if (!(norm > 0.0)) return;
   q0 /= norm;
-  double unused_step = 0;
-  std::int64_t unused_element = -1;
   double theta = 0.0, bound = 0.0;
   Eigen::VectorXd ritz_vector;
   int k = 0;
@@ -310,7 +255,7 @@ void ShellSolver::calibrate_stable_step(double element_step) {
     const Eigen::Matrix3Xd& q = lanczos_basis_[static_cast<std::size_t>(k)];
     const double h = 1e-7 * size / std::max(q.cwiseAbs().maxCoeff(), 1e-300);
     probe_position_ = state_.position + h * q;
-    evaluate_internal_force(probe_position_, false, probe_force_, unused_step, unused_element);
+    evaluate_internal_force(probe_position_, false, probe_force_, nullptr);
     probe_vector_ = ((probe_force_ - state_.internal_force) / h).array().rowwise() / mass.transpose();  // M^-1 K q
     apply_constraints(probe_vector_);
     alpha.push_back(m_dot(q, probe_vector_));
@@ -358,21 +303,12 @@ void ShellSolver::calibrate_stable_step(double element_step) {
   }
 }
 
-void ShellSolver::compute_external_force(double t, const Eigen::Matrix3Xd* nodal_forces) {
+void ExplicitSolver::compute_external_force(double t, const Eigen::Matrix3Xd* nodal_forces) {
   Eigen::Matrix3Xd& f = state_.external_force;
   f.setZero();
   if (pressure_) {
     const double dp = pressure_(t);
-    if (dp != 0.0) {
-      const Eigen::Matrix3Xd& x = state_.position;
-      for (const std::int64_t e : pressure_elements_) {
-        const auto& nodes = model_.elements[static_cast<std::size_t>(e)].nodes;
-        const Eigen::Vector3d area_vector =
-            0.5 * (x.col(nodes[1]) - x.col(nodes[0])).cross(x.col(nodes[2]) - x.col(nodes[0]));
-        const Eigen::Vector3d share = (dp / 3.0) * area_vector;
-        for (int a = 0; a < 3; ++a) f.col(nodes[a]) += share;
-      }
-    }
+    if (dp != 0.0) elements_->add_pressure_force(state_.position, dp, f);
   }
   if (nodal_forces != nullptr) {
     if (nodal_forces->cols() != f.cols()) {
@@ -383,15 +319,15 @@ void ShellSolver::compute_external_force(double t, const Eigen::Matrix3Xd* nodal
   }
 }
 
-void ShellSolver::update_kinetic_energy() {
+void ExplicitSolver::update_kinetic_energy() {
   double kinetic = 0.0;
   for (Eigen::Index i = 0; i < state_.velocity.cols(); ++i) {
-    kinetic += 0.5 * model_.nodal_mass(i) * state_.velocity.col(i).squaredNorm();
+    kinetic += 0.5 * elements_->nodal_mass()(i) * state_.velocity.col(i).squaredNorm();
   }
   state_.energy.kinetic = kinetic;
 }
 
-void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_forces) {
+void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_forces) {
   if (t_end < state_.time) {
     throw std::invalid_argument(
         fmt::format("solid: advance_window to t = {} s, before the current time {} s", t_end, state_.time));
@@ -404,7 +340,7 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
       state_.energy.initial_kinetic = state_.energy.kinetic;
     }
   }
-  const Eigen::ArrayXd inverse_mass = model_.nodal_mass.array().inverse();
+  const Eigen::ArrayXd inverse_mass = elements_->nodal_mass().array().inverse();
   const double alpha = options_.mass_damping_per_s;
   Eigen::Matrix3Xd& x = state_.position;
   Eigen::Matrix3Xd& v_half = state_.half_step_velocity;
@@ -447,12 +383,10 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
     if (alpha > 0.0) {
       for (Eigen::Index i = 0; i < x.cols(); ++i) {
         state_.energy.damping_work +=
-            alpha * model_.nodal_mass(i) * 0.5 * (v_half.col(i) + previous_half_velocity_.col(i)).dot(dx.col(i));
+            alpha * elements_->nodal_mass()(i) * 0.5 * (v_half.col(i) + previous_half_velocity_.col(i)).dot(dx.col(i));
       }
     }
-    state_.energy.internal_work += 0.5 * (state_.internal_force.cwiseProduct(dx)).sum();
-    state_.energy.external_work += 0.5 * (state_.external_force.cwiseProduct(dx)).sum();
-    state_.energy.contact_work -= 0.5 * (state_.contact_force.cwiseProduct(dx)).sum();
+    add_work(dx);
     x += dx;
     state_.time = (dt == remaining) ? t_end : state_.time + dt;
     ++state_.step;
@@ -462,9 +396,7 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
     compute_internal_force(estimate);
     compute_contact_force();
     compute_external_force(state_.time, nodal_forces);
-    state_.energy.internal_work += 0.5 * (state_.internal_force.cwiseProduct(dx)).sum();
-    state_.energy.external_work += 0.5 * (state_.external_force.cwiseProduct(dx)).sum();
-    state_.energy.contact_work -= 0.5 * (state_.contact_force.cwiseProduct(dx)).sum();
+    add_work(dx);
     a = (state_.external_force + state_.contact_force - state_.internal_force).array().rowwise() *
         inverse_mass.transpose();
     apply_constraints(a);
@@ -473,28 +405,14 @@ void ShellSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_for
   }
 }
 
-void ShellSolver::element_fields(Eigen::VectorXd& max_principal_stress,
-                                 Eigen::VectorXd& max_principal_log_strain) const {
-  const auto num_elements = static_cast<Eigen::Index>(model_.elements.size());
-  max_principal_stress.resize(num_elements);
-  max_principal_log_strain.resize(num_elements);
-  std::visit(
-      [&](const auto& law) {
-#pragma omp parallel for schedule(static) if (num_elements >= kMinElementsForThreads)
-        for (Eigen::Index e = 0; e < num_elements; ++e) {
-          try {
-            const ElementFieldValues v =
-                element_field_values(model_, model_.elements[static_cast<std::size_t>(e)], law, state_.position);
-            max_principal_stress(e) = v.max_principal_stress;
-            max_principal_log_strain(e) = v.max_principal_log_strain;
-          } catch (const MaterialStateError&) {
-            // Output of a state the solver could not evaluate: mark it rather than stop.
-            max_principal_stress(e) = std::numeric_limits<double>::quiet_NaN();
-            max_principal_log_strain(e) = std::numeric_limits<double>::quiet_NaN();
-          }
-        }
-      },
-      material_);
+void ExplicitSolver::add_work(const Eigen::Matrix3Xd& dx) {
+  // Trapezoidal increments: half with the forces before the step, half with those after.
+  state_.energy.internal_work += 0.5 * state_.internal_force.cwiseProduct(dx).sum();
+  if (state_.hourglass_force.cols() == dx.cols()) {
+    state_.energy.hourglass_work += 0.5 * state_.hourglass_force.cwiseProduct(dx).sum();
+  }
+  state_.energy.external_work += 0.5 * state_.external_force.cwiseProduct(dx).sum();
+  state_.energy.contact_work -= 0.5 * state_.contact_force.cwiseProduct(dx).sum();
 }
 
 }  // namespace valvefsi::solid

@@ -1,0 +1,184 @@
+#pragma once
+// Explicit central-difference dynamics with lumped mass over any element model (element_model.hpp:
+// shell triangles or 8-node bricks), docs/solid_fe.md "Dynamics". The time loop is one call,
+// advance_window(t_end, forces): FE-only runs call it with the output times, the coupled
+// participant with each coupling window's end. The whole state is the copyable SolverState, so
+// save/restore is assignment. It keeps the energy ledger, sets the stable step (element bound,
+// Lanczos calibration, growth limit), applies fixed nodes, mirror planes, strip ties and contact.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "valvefsi/solid/element_model.hpp"
+#include "valvefsi/solid/leaflet_contact.hpp"
+#include "valvefsi/solid/mesh.hpp"
+
+namespace valvefsi::solid {
+
+struct EnergyBalance {
+  double kinetic = 0;           // (J)
+  double internal_work = 0;     // work of the internal forces (hourglass included) = stored + dissipated (J)
+  double hourglass_work = 0;    // of which the hourglass forces (bricks) (J)
+  double strain_energy = 0;     // hyperelastic energy of the current state (J), for comparison
+  double hourglass_energy = 0;  // hourglass energy of the current state (bricks) (J)
+  double external_work = 0;     // work of pressure and coupler forces (J)
+  double damping_work = 0;      // dissipated by mass-proportional damping (J)
+  double contact_work = 0;      // stored/dissipated in contact penalties (J)
+  double initial_kinetic = 0;
+  // KE + W_int + W_damp + W_contact - W_ext - KE0: zero for exact time integration.
+  double balance() const {
+    return kinetic + internal_work + damping_work + contact_work - external_work - initial_kinetic;
+  }
+  // |balance| relative to the largest energy term.
+  double relative_balance_error() const;
+};
+
+struct SolverState {
+  double time = 0;
+  std::int64_t step = 0;
+  Eigen::Matrix3Xd position;           // x at `time`
+  Eigen::Matrix3Xd half_step_velocity; // v at time - dt/2
+  Eigen::Matrix3Xd velocity;           // v at `time` (for output and kinetic energy)
+  Eigen::Matrix3Xd internal_force;     // at `position` (hourglass included)
+  Eigen::Matrix3Xd hourglass_force;    // its hourglass part (bricks; empty for shells)
+  Eigen::Matrix3Xd external_force;     // at `position`, last evaluated
+  Eigen::Matrix3Xd contact_force;      // at `position`
+  std::int64_t nodes_in_contact = 0;
+  double last_step = 0;                // dt of the last step
+  double stable_step = 0;              // current stable step estimate (safety applied)
+  std::int64_t critical_element = -1;  // element that sets stable_step
+  EnergyBalance energy;
+  // Stable-step calibration (Lanczos on M^-1 K): critical step used / element estimate.
+  double step_calibration = 1.0;
+  double highest_frequency = 0;        // omega_max of the last calibration (rad/s)
+  double calibrated_step = 0;          // 2 / omega_max at the last calibration (s)
+  double element_step_at_calibration = 0;
+  std::int64_t calibrated_at_step = -1;
+  int calibration_iterations = 0;      // Lanczos steps of the last calibration
+  Eigen::Matrix3Xd power_vector;       // last eigenvector estimate
+};
+
+struct SymmetryConstraint {
+  std::int64_t node;
+  Eigen::Vector3d normal;  // the node keeps zero displacement along this unit normal
+};
+
+// Rigid cylinder (stent): nodes keep their distance from the axis at most radius - t/2.
+struct ContactCylinder {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // a point on the axis
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   // unit direction
+  double radius = 0;
+};
+
+// A front/back node pair of a plane-strain strip (2D runs): both move alike in x-y.
+struct StripTie {
+  std::int64_t front;
+  std::int64_t back;
+};
+
+struct SolverOptions {
+  double contact_stiffness_factor = 0.1;  // penalty k = factor * m * omega_max^2 per node
+  double time_step_safety = 0.8;        // fraction of the estimated critical step
+  double mass_damping_per_s = 0.0;      // alpha of the damping force alpha m v (off when 0)
+  int time_step_update_interval = 10;   // re-estimate the stable step every this many steps
+  double max_time_step = 1e-4;          // upper bound on dt (s)
+  // Every this many steps (or when the element estimate falls below 70 % of its value then) the
+  // model's highest frequency is found by Lanczos (finite-difference K v) and the step set from
+  // it; 0 = element estimate only.
+  int time_step_calibration_interval = 0;
+  int power_iterations = 30;            // Lanczos steps at most per calibration (stops when converged)
+  double max_step_calibration = 1.5;     // the calibrated step is at most this times the element estimate
+  double max_time_step_growth = 0;       // > 0: dt grows by at most this fraction per step
+  double fixed_time_step = 0;           // > 0: this step, no estimate (tests of the stability limit)
+};
+
+class ExplicitSolver {
+ public:
+  ExplicitSolver(std::unique_ptr<ElementModel> elements, SolverOptions options = {});
+  virtual ~ExplicitSolver() = default;
+  ExplicitSolver(const ExplicitSolver&) = delete;
+  ExplicitSolver& operator=(const ExplicitSolver&) = delete;
+
+  // Uniform transvalvular pressure dp(t) (Pa) on the element model's loaded surface.
+  void set_pressure_waveform(std::function<double(double)> pressure_Pa);
+  void add_symmetry_constraints(const std::vector<SymmetryConstraint>& constraints);
+  // Rigid plane the leaflet surface (mid-surface offset by t/2 for shells) may touch but not
+  // cross; the plane's normal points to the side where the leaflet lives. Penalty on nodes.
+  void add_contact_plane(const Plane& plane);
+  // Leaflet-leaflet contact between nodes and triangles of different surfaces (ids per node;
+  // empty: any non-incident triangle). Shell elements only (throws std::invalid_argument).
+  void enable_leaflet_contact(std::vector<int> surface_of_node);
+  // Stent: penalty contact keeping every free node inside the cylinder by half its thickness.
+  void add_contact_cylinder(const ContactCylinder& cylinder);
+  // Plane-strain strip (2D runs): u_z = 0 on every node and each pair moves alike in x-y
+  // (mass-weighted, so momentum and the energy balance hold).
+  void set_strip_ties(std::vector<StripTie> ties);
+  const std::vector<StripTie>& strip_ties() const { return ties_; }
+  const LeafletContact* leaflet_contact() const { return leaflet_contact_ ? &*leaflet_contact_ : nullptr; }
+  void set_velocity(const Eigen::Matrix3Xd& velocity);  // initial condition (before the first step)
+
+  // Advances to exactly t_end under `nodal_forces` (3 x nodes, N; constant over the window)
+  // added to the pressure load. Throws MaterialStateError naming the element, time and step.
+  void advance_window(double t_end, const Eigen::Matrix3Xd* nodal_forces = nullptr);
+
+  const SolverState& state() const { return state_; }
+  void restore(const SolverState& saved) {
+    state_ = saved;
+    internal_force_current_ = true;
+  }
+  const ElementModel& elements() const { return *elements_; }
+  const SolverOptions& options() const { return options_; }
+  Eigen::Matrix3Xd displacement() const { return state_.position - elements_->reference_positions(); }
+
+  // Per-element maximum principal Cauchy stress (Pa) and logarithmic strain of the state.
+  void element_fields(Eigen::VectorXd& max_principal_stress, Eigen::VectorXd& max_principal_log_strain) const {
+    elements_->element_fields(state_.position, max_principal_stress, max_principal_log_strain);
+  }
+
+  // For tests: the next estimates use dt = factor x the critical-step estimate (safety ignored).
+  void set_step_factor_for_testing(double factor) { step_factor_ = factor; }
+
+ protected:
+  ElementModel& mutable_elements() { return *elements_; }
+  void invalidate_forces() { internal_force_current_ = false; }
+
+ private:
+  void compute_internal_force(bool estimate_step);
+  // Internal force at x into `out`; returns the element result (energies, step bound).
+  InternalForceResult evaluate_internal_force(const Eigen::Matrix3Xd& x, bool estimate_step, Eigen::Matrix3Xd& out,
+                                              Eigen::Matrix3Xd* hourglass);
+  // Lanczos for omega_max of M^-1 K at the current state; sets the calibration fields of the state.
+  void calibrate_stable_step(double element_step);
+  void compute_external_force(double t, const Eigen::Matrix3Xd* nodal_forces);
+  void compute_contact_force();
+  void apply_constraints(Eigen::Matrix3Xd& field) const;
+  void update_kinetic_energy();
+  void add_work(const Eigen::Matrix3Xd& dx);
+  bool has_contact() const { return !contact_planes_.empty() || !contact_cylinders_.empty() || leaflet_contact_; }
+
+  std::unique_ptr<ElementModel> elements_;
+  SolverOptions options_;
+  std::function<double(double)> pressure_;
+  std::vector<SymmetryConstraint> symmetry_;
+  std::vector<Plane> contact_planes_;
+  std::vector<ContactCylinder> contact_cylinders_;
+  std::vector<StripTie> ties_;
+  bool planar_ = false;  // u_z = 0 everywhere (strip mode)
+  std::optional<LeafletContact> leaflet_contact_;
+  double contact_omega2_ = 0.0;  // frequency^2 fixing the penalty stiffness, set at the first step
+  double step_factor_ = 0.0;     // > 0: tests' override of the safety factor
+  Eigen::VectorXd half_thickness_;  // per node: contact offset of the surface
+  Eigen::Matrix3Xd acceleration_;
+  Eigen::Matrix3Xd previous_half_velocity_;  // for the damping work
+  Eigen::Matrix3Xd probe_position_, probe_force_, probe_vector_;  // calibration work arrays
+  std::vector<Eigen::Matrix3Xd> lanczos_basis_;
+  Eigen::Matrix3Xd step_increment_;
+  bool internal_force_current_ = false;
+  SolverState state_;
+};
+
+}  // namespace valvefsi::solid

@@ -3,8 +3,8 @@
     cd scripts
     /usr/bin/python3 -m sweep run (--preset NAME | --spec FILE.json) --output DIR [--build-dir B]
                                   [--only TEXT] [--dry-run] [--rerun]
-    /usr/bin/python3 -m sweep report DIR [--markdown X.md] [--png X.png] [--tolerance 0.05]
-    /usr/bin/python3 -m sweep stability DIR [--markdown X.md] [--png X.png]
+    /usr/bin/python3 -m sweep report DIR [--markdown X.md] [--png X.png] [--tolerance 0.05] [--refresh]
+    /usr/bin/python3 -m sweep stability DIR [--markdown X.md] [--png X.png] [--refresh]
     /usr/bin/python3 -m sweep presets
 
 `run` runs one setting at a time (niced, one thread per program) and keeps each result in
@@ -51,6 +51,8 @@ def main(argv=None) -> int:
         p.add_argument("output", type=Path)
         p.add_argument("--markdown", type=Path)
         p.add_argument("--png", type=Path)
+        p.add_argument("--refresh", action="store_true",
+                       help="derive metrics and endings again from the run folders (costs are kept)")
         if name == "report":
             p.add_argument("--tolerance", type=float, default=0.05)
     sub.add_parser("presets")
@@ -65,7 +67,7 @@ def main(argv=None) -> int:
         plan.execute(spec, args.output, args.build_dir.resolve(), only=args.only, dry_run=args.dry_run,
                      rerun=args.rerun)
         return 0
-    results = plan.load_results(args.output)
+    results = plan.load_results(args.output, refresh=args.refresh)
     if not results:
         raise SystemExit(f"sweep: no results (*/result.json) in {args.output}")
     spec_path = args.output / "spec.json"

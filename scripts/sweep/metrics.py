@@ -106,6 +106,13 @@ def run_metrics(run_dir: Path, dimension: int = 2, material: str = "MHGO") -> di
                 out["leaks"] = int(np.max(f["interface/leaks"][...], initial=0))
     except OSError:
         pass
+    try:
+        with h5py.File(run_dir / "coupling_series.h5", "r") as f:
+            force = f["force_fluid"][...]
+            if len(force):
+                out["max_interface_force"] = float(np.abs(force).max())
+    except (OSError, KeyError):
+        pass
     events = None
     try:
         solid = read_series(run_dir)

@@ -113,11 +113,8 @@ def execute(spec: dict, output: Path, build_dir: Path, only: str | None = None, 
         run_dir = work / "run"
         cost = runner.run_case(case, run_dir, build_dir, work / "launcher.log", spec.get("wall_limit_s"))
         material = str(run.setting.get("material", "MHGO"))
-        measured = metrics_module.run_metrics(run_dir, dimension=2 if spec["scene"] == "valve2d" else 3,
-                                              material=material)
-        ending = outcome_module.classify(run_dir, cost.exit_code, spec["end_time"], cost.timed_out,
-                                         launcher_log=work / "launcher.log", leaks=measured.get("leaks"),
-                                         max_edge_speed=measured.get("max_edge_speed"))
+        measured, ending = measure(run_dir, work, spec["scene"], run.setting, spec["end_time"], cost.exit_code,
+                                   cost.timed_out)
         result = {"label": run.label, "groups": run.groups, "setting": run.setting, "scene": spec["scene"],
                   "end_time": spec["end_time"], "span": spec.get("span", ""), "material": material,
                   "cost": cost, "core_hours": cost.core_hours, "outcome": ending, "metrics": measured,
@@ -130,5 +127,27 @@ def execute(spec: dict, output: Path, build_dir: Path, only: str | None = None, 
     return results
 
 
-def load_results(output: Path) -> list[dict]:
-    return [json.loads(p.read_text()) for p in sorted(Path(output).glob("*/result.json"))]
+def measure(run_dir: Path, work: Path, scene: str, setting: dict, end_time: float, exit_code: int,
+            timed_out: bool) -> tuple[dict, outcome_module.Outcome]:
+    """Headline metrics and the ending of a finished run folder."""
+    material = str(setting.get("material", "MHGO"))
+    measured = metrics_module.run_metrics(run_dir, dimension=2 if scene == "valve2d" else 3, material=material)
+    ending = outcome_module.classify(run_dir, exit_code, end_time, timed_out, launcher_log=work / "launcher.log",
+                                     leaks=measured.get("leaks"), max_edge_speed=measured.get("max_edge_speed"))
+    return measured, ending
+
+
+def load_results(output: Path, refresh: bool = False) -> list[dict]:
+    """The results of a sweep folder; with `refresh`, metrics and endings are derived again from
+    the run folders (after a change of their definitions; the costs are kept)."""
+    results = []
+    for path in sorted(Path(output).glob("*/result.json")):
+        r = json.loads(path.read_text())
+        if refresh and (path.parent / "run").is_dir():
+            measured, ending = measure(path.parent / "run", path.parent, r["scene"], r["setting"], r["end_time"],
+                                       r["cost"]["exit_code"], r["cost"]["timed_out"])
+            r.update(metrics=measured, outcome=json.loads(json.dumps(ending, default=runner._jsonable)),
+                     reference_errors=metrics_module.reference_errors(measured, r.get("material", "MHGO")))
+            runner.save_json(path, r)
+        results.append(r)
+    return results

@@ -34,10 +34,20 @@ def mu_of(setting: dict) -> float:
 
 
 def groups_of(results: list[dict]) -> dict:
+    """group -> its runs; the run with the base setting (the committed case) joins every group
+    as its reference point."""
     groups: dict[str, list] = {}
     for r in results:
         for g in r["groups"]:
             groups.setdefault(g, []).append(r)
+    shortest = min((len(r["setting"]) for r in results), default=0)
+    bases = [r for r in results if len(r["setting"]) == shortest]
+    if len(bases) == 1:
+        base = bases[0]
+        for members in groups.values():
+            own = {tuple(sorted(k for k in r["setting"] if k not in base["setting"])) for r in members}
+            if base not in members and len(own) == 1 and len(next(iter(own))) == 1:
+                members.append(base)   # only where the group varies one axis from the base
     return groups
 
 
@@ -58,8 +68,8 @@ def markdown(results: list[dict]) -> str:
     if results:
         lines += [f"Span: {results[0].get('span') or results[0]['end_time']}.", ""]
     lines += ["| group | setting | μ | dp / t | end | reached (ms) | stopped by | message or measure "
-              "| max edge speed (m/s) | leaks | wall (s) | CPU (s) |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+              "| max edge speed (m/s) | max interface force (N/m) | leaks | wall (s) | CPU (s) |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for group, members in groups_of(results).items():
         axis = varied_axis(members) or "setting"
         for r in sorted(members, key=lambda r: (str(type(_value(r, axis))), _value(r, axis))):
@@ -73,7 +83,8 @@ def markdown(results: list[dict]) -> str:
             lines.append(f"| {group} | {shown or 'default'} | {mu_of(r['setting']):.2g} | "
                          f"{float(s['spacing_mm']) / float(s['thickness_mm']):.0f} | {o['kind']} | {reached} | "
                          f"{o['detected_by'] or '(not stopped)' if o['kind'] != 'completed' else ''} | {detail} | "
-                         f"{_num(r['metrics'].get('max_edge_speed'))} | {r['metrics'].get('leaks', '–')} | "
+                         f"{_num(r['metrics'].get('max_edge_speed'))} | {_num(r['metrics'].get('max_interface_force'))} | "
+                         f"{r['metrics'].get('leaks', '–')} | "
                          f"{r['cost']['wall_s']:.0f} | {r['cost']['cpu_s']:.0f} |")
     return "\n".join(lines) + "\n"
 
@@ -91,12 +102,14 @@ def chart(results: list[dict], path: Path, title: str = "") -> None:
             end = r["end_time"]
             reached = r["outcome"]["reached_s"] or 0.0
             kind = r["outcome"]["kind"]
-            ax.bar(i, reached / end, color=KIND_COLOURS.get(kind, "black"), label=kind)
+            ax.bar(i, max(reached / end, 0.02), color=KIND_COLOURS.get(kind, "black"), label=kind)
+            if kind != "completed":
+                ax.text(i, max(reached / end, 0.02) + 0.02, kind.replace(" ", "\n"), ha="center", fontsize=6)
         ax.set_xticks(range(len(members)), [str(_value(r, axis)) for r in members], fontsize=8)
         ax.set_xlabel(axis, fontsize=8)
-        ax.set_ylim(0, 1.05)
+        ax.set_ylim(0, 1.3)
         ax.set_title(group, fontsize=9)
-    axes[0][0].set_ylabel("fraction of the span reached")
+    axes[0][0].set_ylabel("fraction of the span reached\n(the run may still end unsound)")
     handles, labels = [], []
     for ax in axes[0]:
         for h, l in zip(*ax.get_legend_handles_labels()):

@@ -17,6 +17,7 @@ the outflow side as in 3D, circumferential axis +z, radial axis along the polyli
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass, field
@@ -32,10 +33,11 @@ from .valve_geometry import ValveParameters
 from .valve_mesh import ValveMesh, leaflet_grid
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
-# Segments per leaflet: the 3D mesh's rows from attachment to free edge (valve_mesh.RESOLUTIONS).
-SEGMENTS = {"coarse": 14, "medium": 28}
-# Fluid particle spacing: about one leaflet segment (1.16 / 0.58 mm).
-PARTICLE_SPACING_2D = {"coarse": 1.0e-3, "medium": 0.5e-3}
+# Segments per leaflet: about one per particle spacing (0.80 mm at coarse).
+SEGMENTS = {"xcoarse": 7, "coarse": 14, "medium": 28}
+# Fluid particle spacing. xcoarse: 23 mm / 12, so that the 23 mm orifice spans whole spacings
+# (both stent faces on lattice planes); the channel's axial faces snap to its lattice.
+PARTICLE_SPACING_2D = {"xcoarse": 23.0e-3 / 12.0, "coarse": 1.0e-3, "medium": 0.5e-3}
 STRIP_DEPTH = 1.0e-3            # m; solid_case.proto's default strip_depth
 LEAFLETS_2D = 2
 PA_PER_MMHG = 133.322387415
@@ -46,6 +48,13 @@ LEAFLET_DENSITY = 1100.0        # kg/m^3 (reference Sec. 2.2)
 # and the fraction of the solid's estimated stable step that survives the stent-plane impacts.
 FE_ONLY_DAMPING_PER_S = 100.0
 FE_ONLY_TIME_STEP_SAFETY = 0.3
+LEAFLET_SHAPES = ("flat", "belly")
+# The 2D FSI cases start the fluid at gauge 0 without a background pressure: with it, the taps read
+# spikes of ~100 mmHg in the opening (xcoarse, measured; docs/fsi-2d.md) and the coarse valve
+# stalled at 0.061 s (the lead's investigation).
+BACKGROUND_PRESSURE_2D = False
+# Contact plane holding the closed 2D valve (docs/fsi-2d.md).
+ANNULUS_PLANE = "annulus"
 
 
 def belly_section(p: ValveParameters, segments: int) -> np.ndarray:
@@ -55,17 +64,29 @@ def belly_section(p: ValveParameters, segments: int) -> np.ndarray:
     return np.stack([column[:, 2], column[:, 0]], axis=1)
 
 
-def leaflet_polylines(p: ValveParameters, segments: int) -> list[np.ndarray]:
+def radial_span(p: ValveParameters, segments: int) -> np.ndarray:
+    """(axial, radial) of the 2D leaflet, [segments + 1, 2]: flat across the annulus plane x = 0
+    from the attachment (0, R) to half the coaptation gap off the axis; its length R - gap/2
+    is the closed 3D leaflet's radial span (docs/fsi-2d.md: why not the belly section)."""
+    radial = np.linspace(p.annulus_radius, 0.5 * p.coaptation_gap, segments + 1)
+    return np.stack([np.zeros_like(radial), radial], axis=1)
+
+
+def leaflet_polylines(p: ValveParameters, segments: int, shape: str = "flat") -> list[np.ndarray]:
     """Mid-lines of the two 2D leaflets in the x-y plane, each [segments + 1, 2], attached end
-    first: leaflet 0 at y > 0, leaflet 1 its mirror image."""
-    section = belly_section(p, segments)
+    first: leaflet 0 at y > 0, leaflet 1 its mirror image. shape "flat" (the cases: the radial
+    span) or "belly" (the 3D belly section, 16.3 mm: no closed 2D state, docs/fsi-2d.md)."""
+    if shape not in LEAFLET_SHAPES:
+        raise ValueError(f"2D leaflet shape '{shape}': allowed {', '.join(LEAFLET_SHAPES)}")
+    section = radial_span(p, segments) if shape == "flat" else belly_section(p, segments)
     upper = section.copy()
     lower = section * np.array([1.0, -1.0])
     return [upper, lower]
 
 
 def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None = None,
-                     strip_depth: float = STRIP_DEPTH, segments: int | None = None) -> ValveMesh:
+                     strip_depth: float = STRIP_DEPTH, segments: int | None = None,
+                     shape: str = "flat") -> ValveMesh:
     """The two leaflets as one-element-deep strips (plane strain in solid_fe)."""
     p = params or ValveParameters()
     p.validate()
@@ -77,7 +98,8 @@ def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None 
         raise ValueError(f"segments {segments}: allowed >= 1")
     if not strip_depth > 0:
         raise ValueError(f"strip_depth {strip_depth!r}: allowed > 0")
-    lines = leaflet_polylines(p, segments)
+    lines = leaflet_polylines(p, segments, shape)
+    leaflets = len(lines)
     n = segments + 1
     front = np.concatenate([np.column_stack([line, np.zeros(n)]) for line in lines])
     back = front + np.array([0.0, 0.0, strip_depth])
@@ -106,8 +128,8 @@ def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None 
         ids = np.asarray(ids, dtype=np.int64)
         return np.sort(np.concatenate([ids, ids + count]))
 
-    attached = [k * n for k in range(LEAFLETS_2D)]
-    free = [k * n + segments for k in range(LEAFLETS_2D)]
+    attached = [k * n for k in range(leaflets)]
+    free = [k * n + segments for k in range(leaflets)]
     mesh.node_sets["strip_front"] = np.arange(count, dtype=np.int64)
     mesh.node_sets["strip_back"] = np.arange(count, 2 * count, dtype=np.int64)
     mesh.node_sets["attachment"] = both_layers(attached)
@@ -120,8 +142,13 @@ def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None 
     face = p.annulus_radius + 0.5 * p.thickness
     mesh.contact_planes["stent_upper"] = (np.array([0.0, face, 0.0]), np.array([0.0, -1.0, 0.0]))
     mesh.contact_planes["stent_lower"] = (np.array([0.0, -face, 0.0]), np.array([0.0, 1.0, 0.0]))
+    # the closed valve's support (docs/fsi-2d.md): the annulus plane x = 0, normal downstream, half
+    # a thickness upstream so that mid-surface nodes keep x >= 0; it stands for the circumferential
+    # load path to the commissures that a 2D section lacks (no frictionless closed equilibrium
+    # exists without it). Opening is untouched: the leaflets move downstream of it.
+    mesh.contact_planes[ANNULUS_PLANE] = (np.array([-0.5 * p.thickness, 0.0, 0.0]), np.array([1.0, 0.0, 0.0]))
     per_leaflet = 2 * segments
-    for k in range(LEAFLETS_2D):
+    for k in range(leaflets):
         mesh.node_sets[f"leaflet_{k}"] = both_layers(np.arange(k * n, (k + 1) * n))
         mesh.element_sets[f"leaflet_{k}_triangles"] = (
             "triangle", np.arange(k * per_leaflet, (k + 1) * per_leaflet, dtype=np.int64))
@@ -130,15 +157,15 @@ def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None 
         "variant": "2d",
         "resolution": resolution if segments == SEGMENTS.get(resolution) else f"{segments}",
         "segments_per_leaflet": segments,
-        "leaflet_count_in_file": LEAFLETS_2D,
+        "leaflet_count_in_file": leaflets,
         "strip_depth": strip_depth,
         **{f"param_{name}": value for name, value in p.__dict__.items()},
     }
     return mesh
 
 
-def leaflet_length(p: ValveParameters, segments: int = 400) -> float:
-    section = belly_section(p, segments)
+def leaflet_length(p: ValveParameters, segments: int = 400, shape: str = "flat") -> float:
+    section = leaflet_polylines(p, segments, shape)[0]
     return float(np.linalg.norm(np.diff(section, axis=0), axis=1).sum())
 
 
@@ -180,6 +207,18 @@ class Channel2D:
             if not ok:
                 raise ValueError(f"2D channel parameter '{name}' = {getattr(self, name)!r}: allowed {allowed}")
 
+    def on_lattice(self, dp: float) -> "Channel2D":
+        """This channel with its axial faces (gasket, commissure tops, plates) moved to the nearest
+        lattice planes of spacing dp (x = 0 is one); the orifice must span whole spacings."""
+        cells = 2.0 * self.stent_radius / dp
+        if abs(cells - round(cells)) > 1e-9:
+            raise ValueError(f"particle spacing {dp!r} m: the {2 * self.stent_radius * 1e3:g} mm orifice must "
+                             f"span a whole number of spacings (it spans {cells:.4f})")
+        snap = lambda x: round(x / dp) * dp
+        return dataclasses.replace(self, stent_start=snap(self.stent_start), stent_end=snap(self.stent_end),
+                                   upstream_length=snap(self.upstream_length),
+                                   downstream_length=snap(self.downstream_length))
+
 
 @functools.lru_cache(maxsize=None)
 def peak_forward_velocity() -> float:
@@ -211,11 +250,13 @@ def _vec(values) -> str:
 
 
 def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Channel2D | None = None,
-                   sound_speed: float | None = None) -> str:
-    """The `fluid { ... }` block of the 2D FSI case (valvefsi.cases.FluidCase, 2-vectors)."""
-    ch = channel or Channel2D()
-    ch.validate()
+                   sound_speed: float | None = None, background: bool = True) -> str:
+    """The `fluid { ... }` block of the 2D FSI case (valvefsi.cases.FluidCase, 2-vectors).
+    background: start the fluid at the aortic pressure at opening as background pressure (else
+    at gauge 0; the plates carry the same offset either way, so gauge pressures are the same)."""
     dp = particle_spacing
+    ch = (channel or Channel2D()).on_lattice(dp)
+    ch.validate()
     c0 = sound_speed or sound_speed_2d()
     half = 0.5 * ch.width
     plate = 3 * dp
@@ -224,11 +265,13 @@ def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Chann
     channel_end = x_out + plate + cycles * ch.plate_travel_per_cycle + 2 * dp
     margin = 6 * dp
     offset = aortic_pressure_at_opening_mmHg()
-    background = offset * PA_PER_MMHG
+    background_Pa = offset * PA_PER_MMHG if background else 0.0
     wall_top = half + margin
+    wall_offset = (half + ch.stent_radius) % dp
+    wall_offset = min(wall_offset, dp - wall_offset)
     lines = [
         "fluid {",
-        f"  particle_spacing: {dp:g}",
+        f"  particle_spacing: {dp:.9g}",
         "  kernel: CUBIC_SPLINE",
         f"  density: {BLOOD_DENSITY:g}",
         "  dynamic_viscosity: 0.0035",
@@ -237,12 +280,15 @@ def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Chann
         "  density_diffusion: 0.1",
         "  # shifting keeps the leaflets' free ends stable (docs/thin-leaflet.md)",
         "  shifting: 1",
-        f"  # the fluid starts at the aortic pressure at opening ({offset:g} mmHg): background pressure",
-        "  # plus the plates' offset below, so neither plate starts with a step load",
-        f"  background_pressure: {background:.9g}",
+        *([f"  # the fluid starts at the aortic pressure at opening ({offset:g} mmHg): background pressure",
+           "  # plus the plates' offset below, so neither plate starts with a step load",
+           f"  background_pressure: {background_Pa:.9g}"] if background else
+          [f"  # no background pressure: gauge 0 = the aortic pressure at opening ({offset:g} mmHg), the",
+           "  # plates' offset below; the diastolic ventricle runs at negative gauge (docs/fsi-2d.md)",
+           "  background_pressure: 0"]),
         f"  domain_lower: {_vec([channel_start - margin, -half - margin])}",
         f"  domain_upper: {_vec([channel_end + margin, half + margin])}",
-        "  # the stent faces y = +-R lie on lattice planes (the channel walls 0.1 mm off them)",
+        f"  # the stent faces y = +-R lie on lattice planes (the channel walls {wall_offset * 1e3:.2g} mm off them)",
         f"  lattice_origin: {_vec([0.0, -ch.stent_radius])}",
         f"  fluid_blocks {{ box {{ lower: {_vec([x_in, -half])} upper: {_vec([x_out, half])} }} }}",
         f"  # the ISO tube's section: a {ch.width * 1e3:.1f} mm channel, extended past the outlet plate by its travel",
@@ -305,18 +351,17 @@ def header_2d(spec: Case2D) -> str:
     from .write_cases import _wrap_comment
     p = ValveParameters()
     ch = Channel2D()
-    leaflet = (f"two {leaflet_length(p) * 1e3:.1f} mm leaflets (the 3D valve's belly section, "
-               f"{SEGMENTS[spec.resolution]} segments each, {p.thickness * 1e3:g} mm thick, "
+    leaflet = (f"two {leaflet_length(p) * 1e3:.2f} mm leaflets (the closed 3D leaflet's radial span, "
+               f"flat across the annulus, {SEGMENTS[spec.resolution]} segments each, {p.thickness * 1e3:g} mm thick, "
                f"plane-strain strips {STRIP_DEPTH * 1e3:g} mm deep), {spec.material} (reference Table 1), "
-               "attached ends fixed on the stent faces")
+               "attached ends fixed on the stent faces, the closed valve held by the annulus contact plane "
+               "(docs/fsi-2d.md)")
     if spec.kind == "FE":
         models = (f"the 2D valve: {leaflet}, under the 75 bpm Wiggers transvalvular pressure applied "
                   f"uniformly on the leaflets with no fluid (FE-only), {CYCLES} cycles.")
-        shows = ("a solver check, not a valve result: the leaflets open in ~25 ms and lie on the stent "
-                 "faces through ejection, swing shut when the gradient reverses (~0.245 s), then slip past "
-                 "each other and prolapse upstream onto the stent faces (measured, solid_fe 2026-11-22): a "
-                 "2D leaflet has no circumferential support, and with frictionless contact a 2D leaflet "
-                 "pair does not close against the reverse gradient (docs/valve-scene.md)")
+        shows = ("the leaflets open within ~30 ms and lie on the stent faces through ejection, swing shut "
+                 "when the gradient reverses (~0.245 s) and lie on the annulus plane through diastole, tips "
+                 "within 0.5 mm of the axis (docs/fsi-2d.md)")
         run = f"/usr/bin/python3 scripts/run_case.py cases/{spec.name}.textproto --output runs/{spec.name} --fe-only"
     else:
         dp = PARTICLE_SPACING_2D[spec.resolution]
@@ -374,7 +419,7 @@ def case_text_2d(spec: Case2D) -> str:
     parts = [header_2d(spec), f"title: \"{title}\"\n", run, waveform.waveform_textproto(), solid]
     if spec.kind == "FSI":
         c0 = sound_speed_2d()
-        parts += [fluid_block_2d(PARTICLE_SPACING_2D[spec.resolution]),
+        parts += [fluid_block_2d(PARTICLE_SPACING_2D[spec.resolution], background=BACKGROUND_PRESSURE_2D),
                   "coupling {\n"
                   "  scheme: SERIAL_EXPLICIT\n"
                   f"  # acoustic estimate mu = 2 rho c dt / (rho_s t) = {2 * BLOOD_DENSITY * c0 * coupling_window(c0) / (LEAFLET_DENSITY * ValveParameters().thickness):.2f} (stable below 2);\n"

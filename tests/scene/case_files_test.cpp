@@ -67,8 +67,8 @@ TEST(SceneCaseFiles, LoadAndMatchTheirNames) {
 }
 
 TEST(SceneCaseFiles, TwoDimensionalCasesLoad) {
-  // scripts/valve_scene/valve2d.py: FE and FSI x Ogden and MHGO x coarse and medium
-  const std::regex name_2d(R"((fe|fsi)-(ogden|mhgo)-2d-(coarse|medium)\.textproto)");
+  // scripts/valve_scene/valve2d.py: FE and FSI x Ogden and MHGO x xcoarse, coarse and medium
+  const std::regex name_2d(R"((fe|fsi)-(ogden|mhgo)-2d-(xcoarse|coarse|medium)\.textproto)");
   int found = 0;
   for (const auto& entry : fs::directory_iterator(VALVEFSI_CASES_DIR)) {
     std::smatch m;
@@ -85,14 +85,17 @@ TEST(SceneCaseFiles, TwoDimensionalCasesLoad) {
     EXPECT_DOUBLE_EQ(c.solid().strip_depth(), 1e-3);
     if (m[1] == "fsi") {
       const auto& f = c.fluid();
-      EXPECT_DOUBLE_EQ(f.particle_spacing(), m[3] == "coarse" ? 1e-3 : 0.5e-3);
+      // xcoarse: the 23 mm orifice in 12 spacings
+      const double spacing = m[3] == "xcoarse" ? 23e-3 / 12 : (m[3] == "coarse" ? 1e-3 : 0.5e-3);
+      EXPECT_NEAR(f.particle_spacing(), spacing, 1e-8 * spacing);  // written to 9 digits
       EXPECT_EQ(f.domain_lower_size(), 2);
       EXPECT_EQ(f.lattice_origin_size(), 2);
       EXPECT_EQ(f.plates_size(), 2);
       EXPECT_EQ(f.plates(0).pressure_source(), valvefsi::cases::FluidPressurePlate::VENTRICULAR);
       EXPECT_EQ(f.plates(1).pressure_source(), valvefsi::cases::FluidPressurePlate::AORTIC);
-      // the plates' offset and the background pressure cancel: no step load at t = 0
-      EXPECT_NEAR(f.plates(0).pressure_mmhg() * valvefsi::kPascalPerMmHg + f.background_pressure(), 0.0, 1e-3);
+      // the fluid starts at gauge 0 (docs/fsi-2d.md) and the plates' offset cancels the
+      // waveform at t = 0: no step load
+      EXPECT_EQ(f.background_pressure(), 0.0);
       const valvefsi::PressureWaveform wf(c.waveform(), name);
       EXPECT_NEAR(wf.aortic_pressure(0.0) + f.plates(1).pressure_mmhg() * valvefsi::kPascalPerMmHg, 0.0, 1.0);
       EXPECT_NEAR(wf.ventricular_pressure(0.0) + f.plates(0).pressure_mmhg() * valvefsi::kPascalPerMmHg, 0.0, 1.0);
@@ -103,7 +106,7 @@ TEST(SceneCaseFiles, TwoDimensionalCasesLoad) {
       EXPECT_LE(c.coupling().window_size(), 1e-5);
     }
   }
-  EXPECT_EQ(found, 8);
+  EXPECT_EQ(found, 12);
 }
 
 TEST(SceneCaseFiles, WaveformGivesTheReferencePressures) {

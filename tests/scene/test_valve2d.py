@@ -57,9 +57,8 @@ class StripMesh(unittest.TestCase):
             n = unit_normals(mesh.nodes, mesh.triangles)
             for k, sign in ((0, 1.0), (1, -1.0)):
                 ids = mesh.element_sets[f"leaflet_{k}_triangles"][1]
-                # base (first segment) faces downstream; the hanging free end faces the stent (the sinus)
-                self.assertGreater(n[ids[0], 0], 0.5)
-                self.assertGreater(sign * n[ids[-1], 1], 0.5)
+                # the flat closed leaflet faces downstream (the aorta) all along
+                np.testing.assert_allclose(n[ids, 0], 1.0, atol=1e-12)
                 np.testing.assert_allclose(n[ids, 2], 0.0, atol=1e-12)
 
     def test_axes_circumferential_out_of_plane_radial_along_the_polyline(self):
@@ -88,13 +87,18 @@ class StripMesh(unittest.TestCase):
                 self.assertEqual(len(ids), 2 * n)
                 self.assertTrue(np.all(np.sign(mesh.nodes[ids, 1]) == (1 if k == 0 else -1)))
 
-    def test_stent_faces_are_contact_planes_the_leaflets_start_clear_of(self):
+    def test_stent_faces_and_annulus_are_contact_planes_the_leaflets_start_clear_of(self):
         for mesh in self.meshes.values():
-            self.assertEqual(sorted(mesh.contact_planes), ["stent_lower", "stent_upper"])
+            self.assertEqual(sorted(mesh.contact_planes), ["annulus", "stent_lower", "stent_upper"])
+            point, normal = mesh.contact_planes["annulus"]
+            # the annulus support: mid-surface nodes keep x >= 0, normal downstream
+            self.assertEqual(list(normal), [1.0, 0.0, 0.0])
+            self.assertAlmostEqual(point[0] + 0.5 * P.thickness, 0.0, delta=1e-15)
             free = np.setdiff1d(np.arange(len(mesh.nodes)), mesh.node_sets["attachment"])
-            for point, normal in mesh.contact_planes.values():
+            for name, (point, normal) in mesh.contact_planes.items():
                 gap = (mesh.nodes - point) @ normal - 0.5 * P.thickness
-                self.assertTrue(np.all(gap[free] > 0))
+                # clear of the stent faces; on the annulus plane, without penetrating it
+                self.assertTrue(np.all(gap[free] > 0) if name != "annulus" else np.all(np.abs(gap) < 1e-15))
                 self.assertAlmostEqual(gap[mesh.node_sets["attachment"]].min(), 0.0, delta=1e-12)
 
     def test_file_round_trip(self):
@@ -110,16 +114,25 @@ class StripMesh(unittest.TestCase):
 
 
 class Geometry(unittest.TestCase):
-    def test_leaflet_is_the_3d_belly_section(self):
-        line = leaflet_polylines(P, 200)[0]
+    def test_leaflet_is_the_closed_radial_span(self):
+        line = leaflet_polylines(P, 20)[0]
+        np.testing.assert_allclose(line[:, 0], 0.0, atol=0)            # flat on the annulus plane
+        self.assertAlmostEqual(line[0, 1], P.annulus_radius, delta=1e-15)
+        self.assertAlmostEqual(line[-1, 1], 0.5 * P.coaptation_gap, delta=1e-15)
+        self.assertAlmostEqual(leaflet_length(P), P.annulus_radius - 0.5 * P.coaptation_gap, delta=1e-12)
+        with self.assertRaisesRegex(ValueError, "shape 'round': allowed flat, belly"):
+            leaflet_polylines(P, 20, "round")
+
+    def test_belly_variant_is_the_3d_belly_section(self):
+        line = leaflet_polylines(P, 200, "belly")[0]
         base, tip = leaflet_point(P, 0.0, 0.0), leaflet_point(P, 0.0, 1.0)
         np.testing.assert_allclose(line[0], [base[2], base[0]], atol=1e-15)
         np.testing.assert_allclose(line[-1], [tip[2], tip[0]], atol=1e-15)
         # uniform arc length, and the length is the section's
         seg = np.linalg.norm(np.diff(line, axis=0), axis=1)
         self.assertLess(seg.max() / seg.min() - 1, 1e-3)
-        self.assertAlmostEqual(seg.sum(), leaflet_length(P), delta=1e-6)
-        self.assertTrue(15e-3 < leaflet_length(P) < 18e-3)
+        self.assertAlmostEqual(seg.sum(), leaflet_length(P, shape="belly"), delta=1e-6)
+        self.assertTrue(15e-3 < leaflet_length(P, shape="belly") < 18e-3)
 
     def test_leaflets_inside_the_orifice_attached_on_the_stent_faces(self):
         ch = Channel2D()
@@ -130,12 +143,14 @@ class Geometry(unittest.TestCase):
                 self.assertTrue(ch.stent_start <= line[0, 0] <= ch.stent_end)
                 self.assertTrue(np.all(np.abs(line[:, 1]) <= ch.stent_radius + 1e-12))
                 self.assertTrue(np.all((line[:, 0] >= 0) & (line[:, 0] < ch.stent_end)))
+                # open, lying on the stent face, the tip stays beside the stent (x < commissure tops)
+                self.assertLess(leaflet_length(P), ch.on_lattice(valve2d.PARTICLE_SPACING_2D[r]).stent_end)
 
     def test_tips_nearly_meet_without_overlap(self):
         upper, lower = leaflet_polylines(P, SEGMENTS["medium"])
         self.assertTrue(np.all(upper[:, 1] > 0) and np.all(lower[:, 1] < 0))
         gap = upper[-1, 1] - lower[-1, 1]
-        self.assertAlmostEqual(gap, P.coaptation_gap / np.sin(np.pi / 3), delta=1e-12)   # 0.577 mm
+        self.assertAlmostEqual(gap, P.coaptation_gap, delta=1e-12)   # 0.5 mm, as in 3D
         self.assertLess(gap, 1e-3)
 
     def test_channel_parameters_are_checked(self):
@@ -173,13 +188,18 @@ class CaseFiles2D(unittest.TestCase):
                     self.assertEqual(vector.count(",") + 1, 2, vector)
 
     def test_stent_faces_and_plate_faces_on_lattice_planes(self):
-        ch = Channel2D()
         for dp in valve2d.PARTICLE_SPACING_2D.values():
+            ch = Channel2D().on_lattice(dp)
             for face in (ch.stent_radius, -ch.stent_radius):
                 k = (face + ch.stent_radius) / dp
                 self.assertAlmostEqual(k, round(k), delta=1e-9)
             for face in (ch.stent_start, ch.stent_end, -ch.upstream_length, ch.downstream_length):
                 self.assertAlmostEqual(face / dp, round(face / dp), delta=1e-9)
+            # snapping moves no face by more than half a spacing
+            self.assertLessEqual(abs(ch.stent_end - Channel2D().stent_end), 0.5 * dp + 1e-12)
+        self.assertEqual(Channel2D().on_lattice(1e-3), Channel2D())
+        with self.assertRaisesRegex(ValueError, "particle spacing 0.002 m: the 23 mm orifice must span a whole"):
+            Channel2D().on_lattice(2e-3)
 
 
 if __name__ == "__main__":

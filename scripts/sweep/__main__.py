@@ -77,9 +77,10 @@ def main(argv=None) -> int:
         if args.png:
             report.chart(results, args.png, plan.finest_label(spec))
     else:
-        text = stability.markdown(results)
+        order = list(dict.fromkeys(entry.get("group", "runs") for entry in spec.get("runs", [])))
+        text = stability.markdown(results, order)
         if args.png:
-            stability.chart(results, args.png)
+            stability.chart(results, args.png, order=order)
     if args.markdown:
         args.markdown.write_text(text)
     sys.stdout.write(text)

@@ -18,6 +18,7 @@ SHOWN = [  # (metric, column title, scale, digits)
     ("eoa", "EOA", 1.0, 3),
     ("rvct", "RVCT (ms)", 1e3, 1),
     ("diastolic_force", "diastolic F", 1.0, 2),
+    ("max_edge_speed", "max edge speed (m/s)", 1.0, 1),   # shown, not a headline metric
 ]
 
 
@@ -27,13 +28,17 @@ def choose_finest(results: list[dict], label: str | None) -> dict | None:
             if r["label"] == label:
                 return r
         return None
-    done = [r for r in results if r["outcome"]["kind"] in ("completed", "leaks")]
+    done = [r for r in results if usable(r)]
     return max(done, key=lambda r: r["cost"]["cpu_s"]) if done else None
 
 
+REACHED_END = ("completed", "leaks", "energy growth")
+
+
 def usable(result: dict) -> bool:
-    """A run whose metrics count: it reached its end (leaks are reported, not disqualifying)."""
-    return result["outcome"]["kind"] in ("completed", "leaks")
+    """A run whose metrics count: it reached its end. Leaks and energy growth (a fluttering
+    free edge, a force spike) do not stop a run; they are shown beside its errors."""
+    return result["outcome"]["kind"] in REACHED_END
 
 
 def with_errors(results: list[dict], finest: dict | None) -> list[dict]:
@@ -61,6 +66,10 @@ def _fmt(value, scale=1.0, digits=2) -> str:
     return f"{value * scale:.{digits}f}"
 
 
+def _short(value) -> str:
+    return f"{value:.4g}" if isinstance(value, float) else str(value)
+
+
 def _pct(value) -> str:
     return "–" if value is None else f"{100 * value:+.1f} %"
 
@@ -83,7 +92,7 @@ def markdown(results: list[dict], finest_label: str | None = None, tolerance: fl
     lines = []
     if results:
         lines.append(f"Span: {results[0].get('span') or 'end time ' + str(results[0]['end_time']) + ' s'}. "
-                     f"Common setting: {', '.join(f'{k} = {v}' for k, v in constant.items()) or 'none'}.")
+                     f"Common setting: {', '.join(f'{k} = {_short(v)}' for k, v in constant.items()) or 'none'}.")
         lines.append("")
     head = axes + ["end", "wall (s)", "core-h", "peak RSS fluid / solid / coupler (MB)"]
     head += [title for _m, title, _s, _d in SHOWN if any(r["metrics"].get(_m) is not None for r in rows)]
@@ -93,7 +102,7 @@ def markdown(results: list[dict], finest_label: str | None = None, tolerance: fl
     lines.append("|" + "---|" * len(head))
     for r in rows:
         rss = r["cost"]["peak_rss_mb_by_program"]
-        cells = [str(r["setting"].get(a)) for a in axes]
+        cells = [_short(r["setting"].get(a)) for a in axes]
         kind = r["outcome"]["kind"]
         reached = r["outcome"]["reached_s"]
         cells.append(kind if kind == "completed" else f"{kind} at {_fmt(reached, 1e3, 1)} ms")
@@ -117,7 +126,8 @@ def markdown(results: list[dict], finest_label: str | None = None, tolerance: fl
         lines.append(f"Cheapest setting within {100 * tolerance:g} % of the finest ({finest['label']}) on every "
                      f"headline metric it has ({', '.join(needed)}): **{best['label']}**, "
                      f"{best['cost']['wall_s']:.0f} s wall, {best['core_hours']:.4f} core-hours "
-                     f"(finest: {finest['cost']['wall_s']:.0f} s, {finest['core_hours']:.4f} core-hours).")
+                     f"(finest: {finest['cost']['wall_s']:.0f} s, {finest['core_hours']:.4f} core-hours); "
+                     f"it ended '{best['outcome']['kind']}', the finest '{finest['outcome']['kind']}'.")
     return "\n".join(lines) + "\n"
 
 
@@ -135,7 +145,7 @@ def chart(results: list[dict], path: Path, finest_label: str | None = None, titl
         for r in rows:
             x, y = r["cost"][key], max(r["max_error"], floor)
             ax.loglog(x, y, "o", color="tab:blue")
-            ax.annotate(", ".join(f"{v}" for k, v in r["setting"].items() if k in varied), (x, y), fontsize=7,
+            ax.annotate(", ".join(_short(v) for k, v in r["setting"].items() if k in varied), (x, y), fontsize=7,
                         xytext=(3, 3), textcoords="offset points")
     markers = dict(zip(metrics_module.HEADLINE, "os^vD<>"))
     plotted = set()

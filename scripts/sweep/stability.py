@@ -4,6 +4,7 @@
 """
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from . import scenes
@@ -33,7 +34,7 @@ def mu_of(setting: dict) -> float:
             / (float(s["leaflet_density"]) * float(s["thickness_mm"]) * 1e-3))
 
 
-def groups_of(results: list[dict]) -> dict:
+def groups_of(results: list[dict], order: list | None = None) -> dict:
     """group -> its runs; the run with the base setting (the committed case) joins every group
     as its reference point."""
     groups: dict[str, list] = {}
@@ -48,6 +49,9 @@ def groups_of(results: list[dict]) -> dict:
             own = {tuple(sorted(k for k in r["setting"] if k not in base["setting"])) for r in members}
             if base not in members and len(own) == 1 and len(next(iter(own))) == 1:
                 members.append(base)   # only where the group varies one axis from the base
+    if order:
+        rank = {g: i for i, g in enumerate(order)}
+        groups = dict(sorted(groups.items(), key=lambda item: rank.get(item[0], len(rank))))
     return groups
 
 
@@ -63,20 +67,20 @@ def _num(value, digits=3) -> str:
     return "–" if value is None else f"{value:.{digits}g}"
 
 
-def markdown(results: list[dict]) -> str:
+def markdown(results: list[dict], order: list | None = None) -> str:
     lines = []
     if results:
         lines += [f"Span: {results[0].get('span') or results[0]['end_time']}.", ""]
     lines += ["| group | setting | μ | dp / t | end | reached (ms) | stopped by | message or measure "
               "| max edge speed (m/s) | max interface force (N/m) | leaks | wall (s) | CPU (s) |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for group, members in groups_of(results).items():
+    for group, members in groups_of(results, order).items():
         axis = varied_axis(members) or "setting"
         for r in sorted(members, key=lambda r: (str(type(_value(r, axis))), _value(r, axis))):
             s = {**scenes.VALVE2D_DEFAULTS, **r["setting"]}
             o = r["outcome"]
             shown = ", ".join(f"{k} = {v}" for k, v in r["setting"].items() if k != "material")
-            detail = (o["detail"] or "").replace("|", "/")
+            detail = re.sub(r"^(\[[^\]]*\]\s*)+", "", (o["detail"] or "")).replace("|", "/")
             if len(detail) > 160:
                 detail = detail[:157] + "..."
             reached = "–" if o["reached_s"] is None else f"{o['reached_s'] * 1e3:.1f}"
@@ -89,11 +93,11 @@ def markdown(results: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def chart(results: list[dict], path: Path, title: str = "") -> None:
+def chart(results: list[dict], path: Path, title: str = "", order: list | None = None) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    groups = groups_of(results)
+    groups = groups_of(results, order)
     fig, axes = plt.subplots(1, len(groups), figsize=(3.0 * max(len(groups), 1), 3.6), squeeze=False)
     for ax, (group, members) in zip(axes[0], groups.items()):
         axis = varied_axis(members) or "setting"

@@ -151,11 +151,11 @@ class Classify(unittest.TestCase):
         write_logs(self.dir, {"coupler": "[error] coupler: NaN in 'loads' from participant 'fluid' at point 3\n"})
         self.assertEqual(outcome.classify(self.dir, 5, 0.1).kind, "nan")
 
-    def test_unnamed_failure_with_a_runaway_force_is_divergence_not_detected(self):
+    def test_unnamed_failure_with_a_runaway_force_is_energy_growth_not_detected(self):
         write_logs(self.dir, {"coupler": "", "fluid": "", "solid": ""})
         write_coupling(self.dir, [0.01, 0.02, 0.03], [[1, 0, 0], [100, 0, 0], [1e4, 0, 0]])
         o = outcome.classify(self.dir, 1, 0.1)
-        self.assertEqual((o.kind, o.detected_by), ("coupling divergence", ""))
+        self.assertEqual((o.kind, o.detected_by), ("energy growth", ""))
 
     def test_completed_with_leaks_and_with_unconverged_windows(self):
         write_logs(self.dir, {"coupler": "", "fluid": "", "solid": ""})

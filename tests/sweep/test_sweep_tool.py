@@ -95,6 +95,19 @@ class Valve2dScene(unittest.TestCase):
         self.assertAlmostEqual(stability.mu_of({"leaflet_density": 275.0}) / stability.mu_of({}), 4.0, places=9)
 
 
+class FileCaseScene(unittest.TestCase):
+    def test_copy_with_end_time_overrides_and_an_absolute_mesh_path(self):
+        source = Path(__file__).resolve().parents[2] / "cases" / "fe-mhgo-sector-coarse.textproto"
+        with tempfile.TemporaryDirectory() as tmp:
+            case = scenes.write_case("case", {"case": str(source), "set:solid.time_step_safety": 0.5},
+                                     Path(tmp) / "w", 0.12)
+            text = case.read_text()
+            self.assertEqual(float(case_edit.get_field(text, "run.end_time")), 0.12)
+            self.assertEqual(float(case_edit.get_field(text, "solid.time_step_safety")), 0.5)
+            mesh = Path(case_edit.get_field(text, "solid.mesh_file").strip('"'))
+            self.assertTrue(mesh.is_absolute() and mesh.is_file(), mesh)
+
+
 class OpeningEvents(unittest.TestCase):
     def test_linear_ramp(self):
         t = np.linspace(0, 0.12, 1201)

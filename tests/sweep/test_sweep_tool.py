@@ -187,7 +187,7 @@ class Classify(unittest.TestCase):
 
 def fake_result(label, cpu, m, kind="completed"):
     return {"label": label, "groups": ["grid"], "setting": {"spacing_mm": label}, "end_time": 0.12, "span": "s",
-            "cost": {"wall_s": cpu, "cpu_s": cpu, "peak_rss_mb_by_program": {}}, "core_hours": cpu / 3600,
+            "cost": {"wall_s": cpu, "cpu_s": cpu, "cpu_s_by_program": {"fluid": cpu}, "peak_rss_mb_by_program": {}}, "core_hours": cpu / 3600,
             "outcome": {"kind": kind, "reached_s": 0.12, "detail": "", "detected_by": ""}, "metrics": m,
             "reference_errors": {}}
 

@@ -86,7 +86,7 @@ def leaflet_polylines(p: ValveParameters, segments: int, shape: str = "flat") ->
 
 def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None = None,
                      strip_depth: float = STRIP_DEPTH, segments: int | None = None,
-                     shape: str = "flat") -> ValveMesh:
+                     shape: str = "flat", channel_width: float | None = None) -> ValveMesh:
     """The two leaflets as one-element-deep strips (plane strain in solid_fe)."""
     p = params or ValveParameters()
     p.validate()
@@ -98,6 +98,9 @@ def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None 
         raise ValueError(f"segments {segments}: allowed >= 1")
     if not strip_depth > 0:
         raise ValueError(f"strip_depth {strip_depth!r}: allowed > 0")
+    channel_width = Channel2D().width if channel_width is None else channel_width
+    if not channel_width > 2 * p.annulus_radius:
+        raise ValueError(f"channel_width {channel_width!r}: allowed > 2 annulus_radius = {2 * p.annulus_radius!r}")
     lines = leaflet_polylines(p, segments, shape)
     leaflets = len(lines)
     n = segments + 1
@@ -136,12 +139,12 @@ def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None 
     mesh.node_sets["free_edge"] = both_layers(free)
     mesh.node_sets["free_edge_midpoints"] = np.array(free, dtype=np.int64)
     mesh.node_sets["triangle_nodes"] = np.arange(2 * count, dtype=np.int64)
-    # the stent faces as rigid contact planes (as the 3D cases' contact cylinder: the face half a
-    # thickness outside the attachment, so the mid-surface stays within |y| <= R): without them
-    # nothing stops a 2D leaflet under FE-only pressure from swinging through the wall
-    face = p.annulus_radius + 0.5 * p.thickness
-    mesh.contact_planes["stent_upper"] = (np.array([0.0, face, 0.0]), np.array([0.0, -1.0, 0.0]))
-    mesh.contact_planes["stent_lower"] = (np.array([0.0, -face, 0.0]), np.array([0.0, 1.0, 0.0]))
+    # the channel walls as rigid contact planes (the leaflets open into the sinus, docs/fsi-2d.md;
+    # the face stays inside the channel): without them nothing stops a 2D leaflet under FE-only
+    # pressure from swinging through the wall
+    face = 0.5 * channel_width
+    mesh.contact_planes["channel_upper"] = (np.array([0.0, face, 0.0]), np.array([0.0, -1.0, 0.0]))
+    mesh.contact_planes["channel_lower"] = (np.array([0.0, -face, 0.0]), np.array([0.0, 1.0, 0.0]))
     # the closed valve's support (docs/fsi-2d.md): the annulus plane x = 0, normal downstream, half
     # a thickness upstream so that mid-surface nodes keep x >= 0; it stands for the circumferential
     # load path to the commissures that a 2D section lacks (no frictionless closed equilibrium
@@ -180,7 +183,10 @@ class Channel2D:
     width: float = TubeSetup().tube_diameter                   # 36.8 mm
     stent_radius: float = ValveParameters().annulus_radius      # orifice half-width (23 mm orifice)
     stent_start: float = TubeSetup().gasket_z - TubeSetup().gasket_thickness   # -6 mm: gasket's upstream face
-    stent_end: float = ValveParameters().commissure_height      # 12 mm: commissure tops
+    # the skirt ends at the annulus: the stent is not modelled downstream of the leaflet base (as
+    # in the reference), so the open leaflets swing into the sinus, the 36.8 mm channel, and the
+    # backflow can get behind them (against a stent face they stayed open, docs/fsi-2d.md)
+    stent_end: float = 0.0
     upstream_length: float = TubeSetup().upstream_length        # leaflet base -> inlet plate
     downstream_length: float = TubeSetup().downstream_length    # leaflet base -> outlet plate
     upstream_tap_distance: float = TubeSetup().upstream_tap_distance      # 1 valve diameter
@@ -195,7 +201,7 @@ class Channel2D:
             ("width", self.width > 2 * self.stent_radius, "> 2 stent_radius"),
             ("stent_radius", self.stent_radius > 0, "> 0"),
             ("stent_start", -self.upstream_length < self.stent_start < 0, "in (-upstream_length, 0)"),
-            ("stent_end", 0 < self.stent_end < self.downstream_length, "in (0, downstream_length)"),
+            ("stent_end", self.stent_start < self.stent_end < self.downstream_length, "in (stent_start, downstream_length)"),
             ("upstream_tap_distance", 0 < self.upstream_tap_distance < self.upstream_length, "in (0, upstream_length)"),
             ("downstream_tap_distance", 0 < self.downstream_tap_distance < self.downstream_length, "in (0, downstream_length)"),
             ("velocity_probe_distance", 0 < self.velocity_probe_distance < self.downstream_length, "in (0, downstream_length)"),
@@ -293,7 +299,7 @@ def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Chann
         f"  fluid_blocks {{ box {{ lower: {_vec([x_in, -half])} upper: {_vec([x_out, half])} }} }}",
         f"  # the ISO tube's section: a {ch.width * 1e3:.1f} mm channel, extended past the outlet plate by its travel",
         f"  walls {{ tube {{ origin: {_vec([channel_start, 0])} axis: [1, 0] length: {channel_end - channel_start:.6g} radius: {half:.6g} }} }}",
-        f"  # gasket + stent: rigid blocks narrowing the channel to the {2 * ch.stent_radius * 1e3:.0f} mm orifice, gasket face to commissure tops",
+        f"  # gasket + skirt: rigid blocks narrowing the channel to the {2 * ch.stent_radius * 1e3:.0f} mm orifice, gasket face to the annulus",
         f"  walls {{ solid_box {{ lower: {_vec([ch.stent_start, ch.stent_radius])} upper: {_vec([ch.stent_end, wall_top])} }} }}",
         f"  walls {{ solid_box {{ lower: {_vec([ch.stent_start, -wall_top])} upper: {_vec([ch.stent_end, -ch.stent_radius])} }} }}",
         "  # inlet plate: left-ventricular pressure",
@@ -354,14 +360,15 @@ def header_2d(spec: Case2D) -> str:
     leaflet = (f"two {leaflet_length(p) * 1e3:.2f} mm leaflets (the closed 3D leaflet's radial span, "
                f"flat across the annulus, {SEGMENTS[spec.resolution]} segments each, {p.thickness * 1e3:g} mm thick, "
                f"plane-strain strips {STRIP_DEPTH * 1e3:g} mm deep), {spec.material} (reference Table 1), "
-               "attached ends fixed on the stent faces, the closed valve held by the annulus contact plane "
+               "attached ends fixed at the skirt's corner (the annulus), opening into the sinus (the channel), "
+               "the closed valve held by the annulus contact plane "
                "(docs/fsi-2d.md)")
     if spec.kind == "FE":
         models = (f"the 2D valve: {leaflet}, under the 75 bpm Wiggers transvalvular pressure applied "
                   f"uniformly on the leaflets with no fluid (FE-only), {CYCLES} cycles.")
-        shows = ("the leaflets open within ~30 ms and lie on the stent faces through ejection, swing shut "
-                 "when the gradient reverses (~0.245 s) and lie on the annulus plane through diastole, tips "
-                 "within 0.5 mm of the axis (docs/fsi-2d.md)")
+        shows = ("the leaflets open within ~30 ms, swing into the sinus onto the channel walls through "
+                 "ejection, swing shut when the gradient reverses (~0.245 s) and lie on the annulus plane "
+                 "through diastole, tips within 0.5 mm of the axis (docs/fsi-2d.md)")
         run = f"/usr/bin/python3 scripts/run_case.py cases/{spec.name}.textproto --output runs/{spec.name} --fe-only"
     else:
         dp = PARTICLE_SPACING_2D[spec.resolution]

@@ -87,9 +87,12 @@ class StripMesh(unittest.TestCase):
                 self.assertEqual(len(ids), 2 * n)
                 self.assertTrue(np.all(np.sign(mesh.nodes[ids, 1]) == (1 if k == 0 else -1)))
 
-    def test_stent_faces_and_annulus_are_contact_planes_the_leaflets_start_clear_of(self):
+    def test_channel_walls_and_annulus_are_contact_planes_the_leaflets_start_clear_of(self):
         for mesh in self.meshes.values():
-            self.assertEqual(sorted(mesh.contact_planes), ["annulus", "stent_lower", "stent_upper"])
+            self.assertEqual(sorted(mesh.contact_planes), ["annulus", "channel_lower", "channel_upper"])
+            point, normal = mesh.contact_planes["channel_upper"]
+            # the wall faces: the leaflet's face may touch the channel wall, not cross it
+            self.assertAlmostEqual(point[1], 0.5 * Channel2D().width, delta=1e-15)
             point, normal = mesh.contact_planes["annulus"]
             # the annulus support: mid-surface nodes keep x >= 0, normal downstream
             self.assertEqual(list(normal), [1.0, 0.0, 0.0])
@@ -97,9 +100,11 @@ class StripMesh(unittest.TestCase):
             free = np.setdiff1d(np.arange(len(mesh.nodes)), mesh.node_sets["attachment"])
             for name, (point, normal) in mesh.contact_planes.items():
                 gap = (mesh.nodes - point) @ normal - 0.5 * P.thickness
-                # clear of the stent faces; on the annulus plane, without penetrating it
-                self.assertTrue(np.all(gap[free] > 0) if name != "annulus" else np.all(np.abs(gap) < 1e-15))
-                self.assertAlmostEqual(gap[mesh.node_sets["attachment"]].min(), 0.0, delta=1e-12)
+                # clear of the channel walls (by the sinus, 6.9 mm); on the annulus plane, not in it
+                if name == "annulus":
+                    self.assertTrue(np.all(np.abs(gap) < 1e-15))
+                else:
+                    self.assertAlmostEqual(gap.min(), 0.5 * Channel2D().width - P.annulus_radius - 0.5 * P.thickness, delta=1e-12)
 
     def test_file_round_trip(self):
         mesh = self.meshes["coarse"]
@@ -140,11 +145,12 @@ class Geometry(unittest.TestCase):
             for k, line in enumerate(leaflet_polylines(P, SEGMENTS[r])):
                 sign = 1.0 if k == 0 else -1.0
                 self.assertAlmostEqual(line[0, 1], sign * ch.stent_radius, delta=1e-12)
-                self.assertTrue(ch.stent_start <= line[0, 0] <= ch.stent_end)
+                # attached at the skirt's downstream corner (the annulus), inside the orifice
+                self.assertEqual(line[0, 0], ch.stent_end)
                 self.assertTrue(np.all(np.abs(line[:, 1]) <= ch.stent_radius + 1e-12))
-                self.assertTrue(np.all((line[:, 0] >= 0) & (line[:, 0] < ch.stent_end)))
-                # open, lying on the stent face, the tip stays beside the stent (x < commissure tops)
-                self.assertLess(leaflet_length(P), ch.on_lattice(valve2d.PARTICLE_SPACING_2D[r]).stent_end)
+                self.assertTrue(np.all(line[:, 0] >= 0))
+                # the skirt ends at the annulus on every lattice: the leaflets open into the sinus
+                self.assertEqual(ch.on_lattice(valve2d.PARTICLE_SPACING_2D[r]).stent_end, 0.0)
 
     def test_tips_nearly_meet_without_overlap(self):
         upper, lower = leaflet_polylines(P, SEGMENTS["medium"])

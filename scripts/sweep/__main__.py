@@ -2,14 +2,15 @@
 
     cd scripts
     /usr/bin/python3 -m sweep run (--preset NAME | --spec FILE.json) --output DIR [--build-dir B]
-                                  [--only TEXT] [--dry-run] [--rerun]
+                                  [--only TEXT] [--dry-run] [--rerun] [--markdown X.md] [--png X.png]
     /usr/bin/python3 -m sweep report DIR [--markdown X.md] [--png X.png] [--tolerance 0.05] [--refresh]
     /usr/bin/python3 -m sweep stability DIR [--markdown X.md] [--png X.png] [--refresh]
     /usr/bin/python3 -m sweep presets
 
 `run` runs one setting at a time (niced, one thread per program) and keeps each result in
 DIR/<label>/result.json, so an interrupted sweep continues where it stopped; `report` and
-`stability` read those results only.
+`stability` read those results only; `run` with --markdown/--png then writes the spec's own
+report (its "report" key: "report" for speed against accuracy, "stability" for the map).
 """
 from __future__ import annotations
 
@@ -46,6 +47,8 @@ def main(argv=None) -> int:
     run.add_argument("--only", help="run only the settings whose label contains this text")
     run.add_argument("--dry-run", action="store_true", help="write the case files only")
     run.add_argument("--rerun", action="store_true", help="run settings again even when a result exists")
+    run.add_argument("--markdown", type=Path, help="then write the spec's report (table) here")
+    run.add_argument("--png", type=Path, help="then draw the spec's chart here")
     for name in ("report", "stability"):
         p = sub.add_parser(name)
         p.add_argument("output", type=Path)
@@ -66,8 +69,12 @@ def main(argv=None) -> int:
         spec = _spec(args)
         plan.execute(spec, args.output, args.build_dir.resolve(), only=args.only, dry_run=args.dry_run,
                      rerun=args.rerun)
-        return 0
+        if args.dry_run or not (args.markdown or args.png):
+            return 0
+        args.command, args.refresh, args.tolerance = spec.get("report", "report"), False, 0.05
     results = plan.load_results(args.output, refresh=args.refresh)
+    if args.command not in ("report", "stability"):
+        raise SystemExit(f"sweep: report kind '{args.command}': allowed report, stability")
     if not results:
         raise SystemExit(f"sweep: no results (*/result.json) in {args.output}")
     spec_path = args.output / "spec.json"

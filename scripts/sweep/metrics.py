@@ -2,10 +2,10 @@
 
 A run may cover only part of the cycle (the opening, 0-120 ms): each metric is computed only
 when the span holds it, and says which span it came from.
-- peak_velocity (m/s): maximum of the velocity plane 15 mm downstream (1 ms moving average,
+- peak_velocity (m/s): maximum of the velocity plane 15 mm downstream (2 ms moving average,
   SPH probes are noisy sample to sample);
-- peak_flow (m^3/s; m^2/s in 2D): maximum of the mean flow over the sections (1 ms average);
-- pspd_mmHg: peak pressure drop between the taps (1 ms average), over the span;
+- peak_flow (m^3/s; m^2/s in 2D): maximum of the mean flow over the sections (2 ms average);
+- pspd_mmHg: peak pressure drop between the taps (2 ms average), over the span;
 - rvot (s): rapid valve opening time, from the free-edge curve: 10 % to 90 % of the way from
   the closed position r(0) to the open plateau (the median of the samples above half the
   excursion); needs the curve to pass 90 %;
@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-SMOOTHING_S = 1.0e-3
+SMOOTHING_S = 2.0e-3   # as valve_scene.hemodynamics.analyse_cycle smooths the flow
 # The reference study (W. Mao, K. Li, W. Sun, Cardiovasc. Eng. Technol. 7(4), 2016; Tables 2
 # and 3; docs/hemodynamics.md): values comparable in kind with a 2D run are the velocity, the
 # pressure drop and the kinematic times; flows, areas and forces are 3D quantities.

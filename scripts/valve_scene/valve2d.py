@@ -86,7 +86,7 @@ def leaflet_polylines(p: ValveParameters, segments: int, shape: str = "flat") ->
 
 def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None = None,
                      strip_depth: float = STRIP_DEPTH, segments: int | None = None,
-                     shape: str = "flat", channel_width: float | None = None) -> ValveMesh:
+                     shape: str = "flat") -> ValveMesh:
     """The two leaflets as one-element-deep strips (plane strain in solid_fe)."""
     p = params or ValveParameters()
     p.validate()
@@ -98,9 +98,6 @@ def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None 
         raise ValueError(f"segments {segments}: allowed >= 1")
     if not strip_depth > 0:
         raise ValueError(f"strip_depth {strip_depth!r}: allowed > 0")
-    channel_width = Channel2D().width if channel_width is None else channel_width
-    if not channel_width > 2 * p.annulus_radius:
-        raise ValueError(f"channel_width {channel_width!r}: allowed > 2 annulus_radius = {2 * p.annulus_radius!r}")
     lines = leaflet_polylines(p, segments, shape)
     leaflets = len(lines)
     n = segments + 1
@@ -139,12 +136,14 @@ def build_strip_mesh(resolution: str = "coarse", params: ValveParameters | None 
     mesh.node_sets["free_edge"] = both_layers(free)
     mesh.node_sets["free_edge_midpoints"] = np.array(free, dtype=np.int64)
     mesh.node_sets["triangle_nodes"] = np.arange(2 * count, dtype=np.int64)
-    # the channel walls as rigid contact planes (the leaflets open into the sinus, docs/fsi-2d.md;
-    # the face stays inside the channel): without them nothing stops a 2D leaflet under FE-only
-    # pressure from swinging through the wall
-    face = 0.5 * channel_width
-    mesh.contact_planes["channel_upper"] = (np.array([0.0, face, 0.0]), np.array([0.0, -1.0, 0.0]))
-    mesh.contact_planes["channel_lower"] = (np.array([0.0, -face, 0.0]), np.array([0.0, 1.0, 0.0]))
+    # the stent as rigid contact planes for the solid only (the 3D cases' stent cylinder: the face
+    # half a thickness outside the attachment, so the mid-surface stays within |y| <= R). The fluid
+    # has no wall there (its skirt ends at the annulus), so blood fills the sinus behind the open
+    # leaflets and can push them shut; without the stop the open 2D flaps folded back into the
+    # sinus, onto the skirt (docs/fsi-2d.md)
+    face = p.annulus_radius + 0.5 * p.thickness
+    mesh.contact_planes["stent_upper"] = (np.array([0.0, face, 0.0]), np.array([0.0, -1.0, 0.0]))
+    mesh.contact_planes["stent_lower"] = (np.array([0.0, -face, 0.0]), np.array([0.0, 1.0, 0.0]))
     # the closed valve's support (docs/fsi-2d.md): the annulus plane x = 0, normal downstream, half
     # a thickness upstream so that mid-surface nodes keep x >= 0; it stands for the circumferential
     # load path to the commissures that a 2D section lacks (no frictionless closed equilibrium
@@ -360,15 +359,15 @@ def header_2d(spec: Case2D) -> str:
     leaflet = (f"two {leaflet_length(p) * 1e3:.2f} mm leaflets (the closed 3D leaflet's radial span, "
                f"flat across the annulus, {SEGMENTS[spec.resolution]} segments each, {p.thickness * 1e3:g} mm thick, "
                f"plane-strain strips {STRIP_DEPTH * 1e3:g} mm deep), {spec.material} (reference Table 1), "
-               "attached ends fixed at the skirt's corner (the annulus), opening into the sinus (the channel), "
+               "attached ends fixed at the skirt's corner (the annulus), opening onto the stent stop with blood behind them (the sinus), "
                "the closed valve held by the annulus contact plane "
                "(docs/fsi-2d.md)")
     if spec.kind == "FE":
         models = (f"the 2D valve: {leaflet}, under the 75 bpm Wiggers transvalvular pressure applied "
                   f"uniformly on the leaflets with no fluid (FE-only), {CYCLES} cycles.")
-        shows = ("the leaflets open within ~30 ms, swing into the sinus onto the channel walls through "
-                 "ejection, swing shut when the gradient reverses (~0.245 s) and lie on the annulus plane "
-                 "through diastole, tips within 0.5 mm of the axis (docs/fsi-2d.md)")
+        shows = ("the leaflets open within ~30 ms onto the stent stop (|y| = R) through ejection, swing shut "
+                 "when the gradient reverses (~0.245 s) and lie on the annulus plane through diastole, tips "
+                 "within 0.5 mm of the axis (docs/fsi-2d.md)")
         run = f"/usr/bin/python3 scripts/run_case.py cases/{spec.name}.textproto --output runs/{spec.name} --fe-only"
     else:
         dp = PARTICLE_SPACING_2D[spec.resolution]

@@ -89,10 +89,10 @@ class StripMesh(unittest.TestCase):
 
     def test_channel_walls_and_annulus_are_contact_planes_the_leaflets_start_clear_of(self):
         for mesh in self.meshes.values():
-            self.assertEqual(sorted(mesh.contact_planes), ["annulus", "channel_lower", "channel_upper"])
-            point, normal = mesh.contact_planes["channel_upper"]
-            # the wall faces: the leaflet's face may touch the channel wall, not cross it
-            self.assertAlmostEqual(point[1], 0.5 * Channel2D().width, delta=1e-15)
+            self.assertEqual(sorted(mesh.contact_planes), ["annulus", "stent_lower", "stent_upper"])
+            point, normal = mesh.contact_planes["stent_upper"]
+            # the solid's stent stop: the mid-surface stays within |y| <= R
+            self.assertAlmostEqual(point[1] - 0.5 * P.thickness, P.annulus_radius, delta=1e-15)
             point, normal = mesh.contact_planes["annulus"]
             # the annulus support: mid-surface nodes keep x >= 0, normal downstream
             self.assertEqual(list(normal), [1.0, 0.0, 0.0])
@@ -100,11 +100,12 @@ class StripMesh(unittest.TestCase):
             free = np.setdiff1d(np.arange(len(mesh.nodes)), mesh.node_sets["attachment"])
             for name, (point, normal) in mesh.contact_planes.items():
                 gap = (mesh.nodes - point) @ normal - 0.5 * P.thickness
-                # clear of the channel walls (by the sinus, 6.9 mm); on the annulus plane, not in it
+                # on the annulus plane, not in it; clear of the stent stop but for the attachment
                 if name == "annulus":
                     self.assertTrue(np.all(np.abs(gap) < 1e-15))
                 else:
-                    self.assertAlmostEqual(gap.min(), 0.5 * Channel2D().width - P.annulus_radius - 0.5 * P.thickness, delta=1e-12)
+                    self.assertTrue(np.all(gap[free] > 0))
+                    self.assertAlmostEqual(gap[mesh.node_sets["attachment"]].min(), 0.0, delta=1e-12)
 
     def test_file_round_trip(self):
         mesh = self.meshes["coarse"]

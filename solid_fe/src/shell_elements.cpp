@@ -51,6 +51,8 @@ InternalForceResult ShellElements::internal_force(const Eigen::Matrix3Xd& x, boo
     thread_forces_.assign(static_cast<std::size_t>(threads), Eigen::Matrix3Xd::Zero(3, n));
   }
   const auto num_elements = static_cast<std::int64_t>(model_.elements.size());
+  hinge_sides_.resize(static_cast<std::size_t>(3 * num_elements));
+  HingeSide* sides = hinge_sides_.data();
   InternalForceResult result;
   std::string error;
   std::visit(
@@ -63,10 +65,13 @@ InternalForceResult ShellElements::internal_force(const Eigen::Matrix3Xd& x, boo
           double local_step = std::numeric_limits<double>::infinity();
           std::int64_t local_critical = -1;
 #pragma omp for schedule(static)
+          for (std::int64_t e = 0; e < num_elements; ++e) own_hinge_sides(model_, e, x, sides);
+          // (implicit barrier: every side is ready)
+#pragma omp for schedule(static)
           for (std::int64_t e = 0; e < num_elements; ++e) {
             try {
               const ElementResult r = add_element_internal_force(
-                  model_, model_.elements[static_cast<std::size_t>(e)], law, x, f, estimate_step);
+                  model_, model_.elements[static_cast<std::size_t>(e)], law, x, f, estimate_step, sides, e);
               local_energy += r.strain_energy;
               if (r.stable_step < local_step) {
                 local_step = r.stable_step;

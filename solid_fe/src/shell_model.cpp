@@ -155,6 +155,8 @@ ShellModel build_shell_model(const Mesh& mesh, const ShellModelOptions& options,
         const auto& ntri = mesh.triangles[static_cast<std::size_t>(found->second.first)];
         const std::int64_t opp = ntri[found->second.second];
         el.opposite[i] = static_cast<std::int32_t>(opp);
+        el.neighbour[i] = static_cast<std::int32_t>(found->second.first);
+        el.neighbour_slot[i] = static_cast<std::int8_t>(found->second.second);
         el.edge_kind[i] = EdgeKind::interior;
         // Unfold the neighbour into this element's plane.
         const Eigen::Vector3d Xa = node(mesh, a), Xb = node(mesh, b), Xo = node(mesh, opp);

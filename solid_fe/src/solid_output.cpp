@@ -124,6 +124,14 @@ void SeriesWriter::sample(const ExplicitSolver& solver, double pressure_Pa) {
   columns_["time"].push_back(s.time);
   columns_["step"].push_back(static_cast<double>(s.step));
   columns_["time_step"].push_back(s.stable_step);
+  // Where the step comes from: the dt last used (growth limit and contact included), the element
+  // that bounds it, the factor the calibration applies to the element bound, and the factor the
+  // Lanczos step alone (2 / omega_max) would allow at the last calibration.
+  columns_["time_step_source/last"].push_back(s.last_step);
+  columns_["time_step_source/critical_element"].push_back(static_cast<double>(s.critical_element));
+  columns_["time_step_source/calibration"].push_back(s.step_calibration);
+  columns_["time_step_source/lanczos_over_element"].push_back(
+      s.element_step_at_calibration > 0 ? s.calibrated_step / s.element_step_at_calibration : 0.0);
   columns_["transvalvular_pressure_Pa"].push_back(pressure_Pa);
   columns_["energy/kinetic"].push_back(e.kinetic);
   columns_["energy/internal_work"].push_back(e.internal_work);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "valvefsi/solid/element_model.hpp"
+#include "valvefsi/solid/hinge_angle.hpp"
 #include "valvefsi/solid/material.hpp"
 #include "valvefsi/solid/shell_model.hpp"
 
@@ -38,6 +39,7 @@ class ShellElements final : public ElementModel {
   Material material_;
   std::vector<std::int64_t> pressure_elements_;
   std::vector<Eigen::Matrix3Xd> thread_forces_;  // per-thread accumulation, allocated once
+  std::vector<HingeSide> hinge_sides_;           // 3 per element, refreshed at each evaluation
 };
 
 }  // namespace valvefsi::solid

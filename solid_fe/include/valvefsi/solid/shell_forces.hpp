@@ -34,7 +34,19 @@ struct ElementState {
   std::array<HingeSide, 3> neighbour_side;
 };
 
-inline ElementState element_kinematics(const ShellModel& model, const ShellElement& el, const Eigen::Matrix3Xd& x) {
+// Each triangle's own hinge sides (3 per element, slot i about edge i) at x, for all elements:
+// an interior edge's two sides are then computed once per step, not once by each of its triangles.
+inline void own_hinge_sides(const ShellModel& model, std::int64_t e, const Eigen::Matrix3Xd& x, HingeSide* sides) {
+  const ShellElement& el = model.elements[static_cast<std::size_t>(e)];
+  for (int i = 0; i < 3; ++i) {
+    if (el.edge_kind[i] == EdgeKind::free) continue;
+    sides[3 * e + i] = hinge_side(x.col(el.nodes[(i + 1) % 3]), x.col(el.nodes[(i + 2) % 3]), x.col(el.nodes[i]), false);
+  }
+}
+
+// `sides`: all elements' own hinge sides at x (own_hinge_sides), or nullptr to compute them here.
+inline ElementState element_kinematics(const ShellModel& model, const ShellElement& el, const Eigen::Matrix3Xd& x,
+                                       const HingeSide* sides = nullptr, std::int64_t index = -1) {
   ElementState s;
   s.deformation_gradient.setZero();
   for (int a = 0; a < 3; ++a) {
@@ -46,8 +58,15 @@ inline ElementState element_kinematics(const ShellModel& model, const ShellEleme
     const Eigen::Vector3d& xb = x.col(el.nodes[(i + 2) % 3]);
     switch (el.edge_kind[i]) {
       case EdgeKind::interior: {
-        s.own_side[i] = hinge_side(xa, xb, x.col(el.nodes[i]), false);
-        s.neighbour_side[i] = hinge_side(xa, xb, x.col(el.opposite[i]), true);
+        if (sides != nullptr) {
+          s.own_side[i] = sides[3 * index + i];
+          // The neighbour's own side about the same edge runs b -> a: swap its start and end.
+          const HingeSide& other = sides[3 * static_cast<std::int64_t>(el.neighbour[i]) + el.neighbour_slot[i]];
+          s.neighbour_side[i] = {other.unit_normal, other.grad_opposite, other.grad_end, other.grad_start};
+        } else {
+          s.own_side[i] = hinge_side(xa, xb, x.col(el.nodes[i]), false);
+          s.neighbour_side[i] = hinge_side(xa, xb, x.col(el.opposite[i]), true);
+        }
         s.fold_angle_change(i) = fold_angle(s.own_side[i], s.neighbour_side[i], xa, xb) -
                                  el.reference_fold_angle[i];
         break;
@@ -56,14 +75,14 @@ inline ElementState element_kinematics(const ShellModel& model, const ShellEleme
         const Plane& plane = model.mirror_planes[static_cast<std::size_t>(el.mirror_plane[i])];
         const Eigen::Vector3d xo = x.col(el.nodes[i]);
         const Eigen::Vector3d ghost = xo - 2.0 * (xo - plane.point).dot(plane.normal) * plane.normal;
-        s.own_side[i] = hinge_side(xa, xb, xo, false);
+        s.own_side[i] = sides != nullptr ? sides[3 * index + i] : hinge_side(xa, xb, xo, false);
         s.neighbour_side[i] = hinge_side(xa, xb, ghost, true);
         s.fold_angle_change(i) = fold_angle(s.own_side[i], s.neighbour_side[i], xa, xb) -
                                  el.reference_fold_angle[i];
         break;
       }
       case EdgeKind::clamped: {
-        s.own_side[i] = hinge_side(xa, xb, x.col(el.nodes[i]), false);
+        s.own_side[i] = sides != nullptr ? sides[3 * index + i] : hinge_side(xa, xb, x.col(el.nodes[i]), false);
         s.fold_angle_change(i) = clamped_angle(s.own_side[i], el.reference_normal, xa, xb);
         break;
       }
@@ -114,8 +133,9 @@ struct ElementResult {
 template <class Law>
 ElementResult add_element_internal_force(const ShellModel& model, const ShellElement& el, const Law& law,
                                          const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& forces,
-                                         bool estimate_step) {
-  const ElementState s = element_kinematics(model, el, x);
+                                         bool estimate_step, const HingeSide* sides = nullptr,
+                                         std::int64_t index = -1) {
+  const ElementState s = element_kinematics(model, el, x, sides, index);
   ElementResult result;
   Eigen::Matrix2d N = Eigen::Matrix2d::Zero(), M = Eigen::Matrix2d::Zero();
   const double half_thickness = 0.5 * el.thickness;

@@ -24,6 +24,10 @@ struct ShellElement {
   std::array<std::int32_t, 3> nodes{};
   // Neighbour's node opposite edge i (edge i joins nodes[(i+1)%3] -> nodes[(i+2)%3]); -1 if none.
   std::array<std::int32_t, 3> opposite{-1, -1, -1};
+  // Interior edge i: the neighbour triangle and its slot for the same edge (its own hinge side
+  // there is this element's neighbour side, start and end swapped); -1 if none.
+  std::array<std::int32_t, 3> neighbour{-1, -1, -1};
+  std::array<std::int8_t, 3> neighbour_slot{-1, -1, -1};
   std::array<EdgeKind, 3> edge_kind{EdgeKind::free, EdgeKind::free, EdgeKind::free};
   std::array<double, 3> reference_fold_angle{};  // theta0 of interior and mirror edges
   std::array<std::int8_t, 3> mirror_plane{-1, -1, -1};  // index into ShellModel::mirror_planes

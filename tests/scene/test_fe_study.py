@@ -80,3 +80,29 @@ class FeStudyAnalysis(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class OpeningMetrics(unittest.TestCase):
+    def test_linear_opening_gives_its_crossings_and_peaks(self):
+        from valve_scene.fe_study import opening_metrics
+        with tempfile.TemporaryDirectory() as tmp:
+            run = Path(tmp)
+            t = np.arange(0, 0.1 + 1e-9, 1e-4)
+            r = np.interp(t, [0, 0.002, 0.012, 0.1], [1e-3, 1e-3, 11e-3, 11e-3])   # 1 -> 11 mm over 2-12 ms
+            positions = np.stack([r, np.zeros_like(r), np.full_like(r, 0.011)], axis=1)[:, None, :]
+            ts = np.arange(0, 0.1 + 1e-9, 0.002)
+            with h5py.File(run / "solid_series.h5", "w") as f:
+                f["time"] = t
+                f["monitor/free_edge_midpoints/position"] = positions
+                f["snapshots/time"] = ts
+                f["snapshots/peak_max_principal_log_strain"] = np.where(ts == 0.04, 0.25, 0.1)   # at 40 ms: in
+                f["snapshots/peak_max_principal_stress"] = np.where(ts == 0.08, 9e6, 1e6)       # at 80 ms: out
+            m = opening_metrics(run, end_s=0.06)
+            self.assertAlmostEqual(m["opening_start_s"], 0.003, delta=1e-9)   # 10 %: 2 mm
+            self.assertAlmostEqual(m["opening_end_s"], 0.011, delta=1e-9)     # 90 %: 10 mm
+            self.assertAlmostEqual(m["rvot_s"], 0.008, delta=1e-9)
+            self.assertAlmostEqual(m["r_open_m"], 0.011, delta=1e-12)
+            self.assertEqual(m["peak_log_strain"], 0.25)
+            self.assertEqual(m["peak_stress_Pa"], 1e6)
+            with self.assertRaisesRegex(ValueError, "ends at 0.1 s, before 0.2 s"):
+                opening_metrics(run, end_s=0.2)

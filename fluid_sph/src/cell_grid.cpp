@@ -113,6 +113,7 @@ void CellGrid<D>::sort(Particles<D>& p) {
   p.fluid_mask.resize(n);
   p.inverse_density.resize(n);
   p.near_fluid.resize(n);
+  p.near_wall.resize(n);
   // One parallel region for all arrays: the gathers share no barrier until the end.
 #pragma omp parallel
   {
@@ -131,7 +132,9 @@ void CellGrid<D>::sort(Particles<D>& p) {
 }
 
 template <int D>
-int CellGrid<D>::neighbour_segments(std::size_t cell, std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& out) const {
+int CellGrid<D>::neighbour_segments(std::size_t cell, std::size_t last_cell,
+                                    std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& out) const {
+  const int last_x = static_cast<int>(last_cell % static_cast<std::size_t>(counts_[0]));
   std::array<int, D> c{};
   std::size_t rest = cell;
   for (int d = 0; d < D; ++d) {
@@ -163,7 +166,7 @@ int CellGrid<D>::neighbour_segments(std::size_t cell, std::array<NeighbourSegmen
     row_base *= static_cast<std::size_t>(counts_[0]);
     // Along x: the in-range part is one contiguous segment; wrapped cells are their own.
     const int x_lo = std::max(c[0] - 1, 0);
-    const int x_hi = std::min(c[0] + 1, counts_[0] - 1);
+    const int x_hi = std::min(last_x + 1, counts_[0] - 1);
     out[produced++] = {start_[row_base + x_lo], start_[row_base + x_hi + 1], shift};
     if (periodic_[0]) {
       const double length = upper_[0] - lower_[0];
@@ -173,7 +176,7 @@ int CellGrid<D>::neighbour_segments(std::size_t cell, std::array<NeighbourSegmen
         const std::size_t cc = row_base + counts_[0] - 1;
         out[produced++] = {start_[cc], start_[cc + 1], s};
       }
-      if (c[0] + 1 >= counts_[0]) {
+      if (last_x + 1 >= counts_[0]) {
         auto s = shift;
         s[0] = length;
         out[produced++] = {start_[row_base], start_[row_base + 1], s};

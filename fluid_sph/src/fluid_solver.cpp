@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -80,13 +81,21 @@ void FluidSolver<D>::refresh_mirror_images() {
   auto& p = particles_;
   // Drop last step's images (compacting every array), then mirror every fluid and wall
   // particle within a support of a plane: x' = x - 2 d n, v' = v - 2 (v.n) n.
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (is_mirror(p.kind[i])) continue;
-    if (kept != i) p.for_each_array([&](auto& a) { a[kept] = a[i]; });
-    ++kept;
-  }
-  p.for_each_array([&](auto& a) { a.resize(kept); });
+  // One tight loop per array (the images are spread over the cells after the sort, so nearly
+  // every particle moves): the arrays are compacted in parallel, each in place in order.
+  mirror_keep_.clear();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (!is_mirror(p.kind[i])) mirror_keep_.push_back(static_cast<std::uint32_t>(i));
+  const std::size_t kept = mirror_keep_.size();
+  std::vector<std::function<void()>> compactions;
+  p.for_each_array([&](auto& a) {
+    compactions.emplace_back([&a, this, kept]() {
+      for (std::size_t j = 0; j < kept; ++j) a[j] = a[mirror_keep_[j]];
+      a.resize(kept);
+    });
+  });
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::size_t c = 0; c < compactions.size(); ++c) compactions[c]();
   const double support = settings_.support_radius();
   // A fluid particle that stepped across a plane swaps roles with its image, which stepped
   // the other way: reflect it back (position and normal velocity), as a specular wall would.
@@ -227,13 +236,14 @@ void FluidSolver<D>::evaluate_rates() {
   for (std::size_t k = 0; k < plates_.size(); ++k)
     for (int d = 0; d < D; ++d) body_acceleration_[k + 1][d] = plates_[k].acceleration * plates_[k].normal[d];
   update_wall_state<D>(particles_, grid_, settings_, body_acceleration_, filter);
-  compute_fluid_rates<D>(particles_, grid_, settings_, filter);
-  if (surface_) surface_->add_surface_rates(particles_);
   if (!plates_.empty() || body_forces_requested_ || body_forces_always_) {
-    body_forces_ = compute_body_forces<D>(particles_, grid_, settings_, plates_.size() + 1,
-                                          body_forces_requested_ || body_forces_always_, filter);
+    body_forces_.assign(plates_.size() + 1, Vec<D>{});
+    compute_fluid_rates<D>(particles_, grid_, settings_, filter, &body_forces_, body_forces_requested_ || body_forces_always_);
     body_forces_requested_ = false;
+  } else {
+    compute_fluid_rates<D>(particles_, grid_, settings_, filter);
   }
+  if (surface_) surface_->add_surface_rates(particles_);
 }
 
 template <int D>

@@ -159,110 +159,313 @@ inline Rates3 pair_sums(const ParticleView<D>& p, const PairConstants<D>& k, con
 // zero) and each neighbour b is broadcast, so the sums stay in per-lane accumulators with no
 // horizontal reduction and no remainder loop. Only lanes that are fluid are written back.
 constexpr int kLanes = 8;
-constexpr int kBlock = 64;  // lanes per pass; larger cells are processed in several passes
+constexpr int kBlock = 16;  // lanes per block (for_each_lane_block)
+constexpr int kMaxBookedBodies = 8;  // more bodies: the separate compute_body_forces pass
+
+// One block of lanes: the state of its particles and their per-lane sums.
+struct alignas(64) LaneBlock {
+  alignas(64) float x[3][kBlock], v[3][kBlock], w[3][kBlock], p[kBlock], inv[kBlock], ex[kBlock];
+  alignas(64) float acc[3][kBlock], cont[kBlock], diff[kBlock], csum[kBlock], cg[3][kBlock];
+  alignas(64) float keep[kBlock];
+  alignas(64) float fluid[kBlock];  // 1 where the lane acts as fluid (its reaction is booked)
+  alignas(64) float booked[kMaxBookedBodies][3][kBlock];  // pair accelerations from each body's walls
+};
+
+// A broadcast neighbour b (position already shifted by its periodic image).
+struct Neighbour {
+  float x, y, z, vx, vy, vz, wx, wy, wz, p, inv, ex, fluid;
+};
+
+// Adds neighbour b's terms to every lane. Book: the pair accelerations are also summed into
+// `book` (the lanes' pull from a wall body, whose reaction is the force on that body).
+template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, bool Book, class Kernel>
+inline void add_neighbour(LaneBlock& L, const Neighbour& b, int padded, const PairConstants<D>& k, const Kernel& W,
+                          float* __restrict book) {
+  float* __restrict bx = book;
+  float* __restrict by = Book ? book + kBlock : nullptr;
+  float* __restrict bz = Book ? book + 2 * kBlock : nullptr;
+#pragma omp simd simdlen(8)
+  for (int i = 0; i < padded; ++i) {
+    const float dx = L.x[0][i] - b.x, dy = L.x[1][i] - b.y, dz = D == 3 ? L.x[2][i] - b.z : 0.0f;
+    const float r2 = dx * dx + dy * dy + dz * dz;
+    const float r = std::sqrt(r2);
+    float F = W.gradient_factor(r);
+    if constexpr (Masked) F *= L.keep[i];
+    const float inv_rr = L.inv[i] * b.inv;
+    const float vdx = (L.v[0][i] - b.vx) * dx + (L.v[1][i] - b.vy) * dy + (D == 3 ? (L.v[2][i] - b.vz) * dz : 0.0f);
+    L.cont[i] += vdx * F;
+    // Against a wall only the fluid's positive pressure counts: walls push, never pull
+    // (a tensile surge tip would otherwise be sucked into the wall it hits).
+    const float pa_wall = std::max(L.p[i], 0.0f);
+    float radial = -(b.p + pa_wall + b.fluid * (L.p[i] - pa_wall)) * inv_rr;
+    if constexpr (WithArtificialViscosity) {
+      const float mu_ab = k.h * std::min(vdx, 0.0f) / (r2 + k.eta2);
+      radial += k.alpha_c0 * mu_ab * 0.5f * (L.inv[i] + b.inv);
+    }
+    radial *= F;
+    const float viscous = k.two_mu * inv_rr * F;
+    const float ax = radial * dx + viscous * (L.w[0][i] - b.wx);
+    const float ay = radial * dy + viscous * (L.w[1][i] - b.wy);
+    const float az = D == 3 ? radial * dz + viscous * (L.w[2][i] - b.wz) : 0.0f;
+    L.acc[0][i] += ax;
+    L.acc[1][i] += ay;
+    if constexpr (D == 3) L.acc[2][i] += az;
+    if constexpr (Book) {
+      bx[i] += L.fluid[i] * ax;
+      by[i] += L.fluid[i] * ay;
+      if constexpr (D == 3) bz[i] += L.fluid[i] * az;
+    }
+    float g_dot_rba = -(k.gravity[0] * dx + k.gravity[1] * dy);
+    if constexpr (D == 3) g_dot_rba -= k.gravity[D - 1] * dz;
+    L.diff[i] += b.fluid * (b.ex - L.ex[i] - k.hydrostatic * g_dot_rba) * (-F) * b.inv;
+    if constexpr (WithKernelSum) {
+      L.csum[i] += W.value(r) * (Masked ? L.keep[i] : 1.0f) * b.inv;
+      L.cg[0][i] += F * dx * b.inv;
+      L.cg[1][i] += F * dy * b.inv;
+      if constexpr (D == 3) L.cg[2][i] += F * dz * b.inv;
+    }
+  }
+}
+
+// Bounding box of a block's lanes. A neighbour farther than a support from it meets no lane,
+// and the box test is far cheaper than the SIMD pass over the lanes: it drops about half of
+// the candidates of the neighbour cells in 3D.
+template <int D>
+inline void lane_box(const float (&x)[3][kBlock], int n, float* lo, float* hi) {
+  for (int d = 0; d < D; ++d) {
+    lo[d] = hi[d] = x[d][0];
+    for (int i = 1; i < n; ++i) {
+      lo[d] = std::min(lo[d], x[d][i]);
+      hi[d] = std::max(hi[d], x[d][i]);
+    }
+  }
+}
+template <int D>
+inline bool near_box(const float* lo, const float* hi, float x, float y, float z, float support2) {
+  const float q[3] = {x, y, z};
+  float outside2 = 0.0f;
+  for (int d = 0; d < D; ++d) {
+    const float gap = std::max(std::max(lo[d] - q[d], q[d] - hi[d]), 0.0f);
+    outside2 += gap * gap;
+  }
+  return outside2 < support2;
+}
+
+// Which wall bodies' reactions compute_fluid_rates books, and where (one row per thread).
+template <int D>
+struct BodyBooking {
+  int body_count = 0;          // 0: none
+  bool include_fixed = false;  // book body 0 (the fixed walls) too
+  double* thread_forces = nullptr;  // body_count * D doubles for the calling thread
+  bool books(const Particles<D>& p, std::uint32_t b) const {
+    return p.kind[b] == Kind::wall && p.body[b] < body_count && (p.body[b] != 0 || include_fixed);
+  }
+};
 
 // Masked (cells whose neighbourhood holds a near-surface particle): a per-lane weight of 0
 // leaves out the pairs the filter blocks; it is recomputed only for neighbours b where a
 // block or b is near the surface, so the SIMD sums themselves are unchanged.
-template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, class Kernel>
+// Bodies: the reaction of every fluid-wall pair on the wall's body is booked as it goes
+// (Newton's third law: the pair terms are antisymmetric), so the plates and wall loads need
+// no pass of their own over the wall particles.
+template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, bool Bodies, class Kernel>
 [[gnu::noinline]] void cell_block_rates(Particles<D>& particles, const ParticleView<D>& p, const PairConstants<D>& k, const Kernel& W,
-                      std::uint32_t first, std::uint32_t last,
+                      const std::uint32_t* lane_index, int n,
                       const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments, int segment_count,
-                      const PairFilter<D>& filter) {
-  alignas(64) float xa[3][kBlock], va[3][kBlock], wa[3][kBlock], pa[kBlock], inva[kBlock], exa[kBlock];
-  alignas(64) float acc[3][kBlock], cont[kBlock], diff[kBlock], csum[kBlock], cg[3][kBlock];
-  alignas(64) float keep[kBlock];
-  for (std::uint32_t block = first; block < last; block += kBlock) {
-    const int n = static_cast<int>(std::min<std::uint32_t>(kBlock, last - block));
+                      const PairFilter<D>& filter, LaneBlock& L, const BodyBooking<D>& booking) {
+  {
     const int padded = (n + kLanes - 1) / kLanes * kLanes;
     bool block_near = false;
     if constexpr (Masked) {
-      for (int i = 0; i < kBlock; ++i) keep[i] = 1.0f;
-      for (int i = 0; i < n; ++i) block_near = block_near || filter.is_near(block + static_cast<std::uint32_t>(i));
+      for (int i = 0; i < kBlock; ++i) L.keep[i] = 1.0f;
+      for (int i = 0; i < n; ++i) block_near = block_near || filter.is_near(lane_index[i]);
     }
     bool keep_dirty = false;
     for (int i = 0; i < padded; ++i) {
       const bool real = i < n;
-      const std::uint32_t a = block + static_cast<std::uint32_t>(real ? i : 0);
+      const std::uint32_t a = lane_index[real ? i : 0];
       for (int d = 0; d < 3; ++d) {
         const bool axis = d < D;
-        xa[d][i] = axis ? (real ? p.x[d][a] : 1e15f) : 0.0f;
-        va[d][i] = axis ? p.v[d][a] : 0.0f;
-        wa[d][i] = axis ? p.vv[d][a] : 0.0f;
-        acc[d][i] = 0.0f;
-        cg[d][i] = 0.0f;
+        L.x[d][i] = axis ? (real ? p.x[d][a] : 1e15f) : 0.0f;
+        L.v[d][i] = axis ? p.v[d][a] : 0.0f;
+        L.w[d][i] = axis ? p.vv[d][a] : 0.0f;
+        L.acc[d][i] = 0.0f;
+        L.cg[d][i] = 0.0f;
       }
-      pa[i] = p.pressure[a];
-      inva[i] = p.inverse_density[a];
-      exa[i] = p.excess[a];
-      cont[i] = diff[i] = csum[i] = 0.0f;
+      L.p[i] = p.pressure[a];
+      L.inv[i] = p.inverse_density[a];
+      L.ex[i] = p.excess[a];
+      L.fluid[i] = real ? p.fluid[a] : 0.0f;
+      L.cont[i] = L.diff[i] = L.csum[i] = 0.0f;
     }
+    unsigned booked_bodies = 0;  // bit k: body k got a pair this block
+    float box_lo[3] = {0, 0, 0}, box_hi[3] = {0, 0, 0};
+    lane_box<D>(L.x, n, box_lo, box_hi);
     for (int sidx = 0; sidx < segment_count; ++sidx) {
       const auto& seg = segments[sidx];
       float shift[3] = {0, 0, 0};
       for (int d = 0; d < D; ++d) shift[d] = static_cast<float>(seg.shift[d]);
       for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
-        const float xb = p.x[0][b] + shift[0], yb = p.x[1][b] + shift[1], zb = D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f;
-        const float vxb = p.v[0][b], vyb = p.v[1][b], vzb = D == 3 ? p.v[D - 1][b] : 0.0f;
-        const float wxb = p.vv[0][b], wyb = p.vv[1][b], wzb = D == 3 ? p.vv[D - 1][b] : 0.0f;
-        const float p_b = p.pressure[b], inv_b = p.inverse_density[b], ex_b = p.excess[b], is_fluid = p.fluid[b];
+        const float nb_x[3] = {p.x[0][b] + shift[0], p.x[1][b] + shift[1], D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f};
+        if (!near_box<D>(box_lo, box_hi, nb_x[0], nb_x[1], nb_x[2], k.support2)) continue;
+        const Neighbour nb{nb_x[0], nb_x[1], nb_x[2],
+                           p.v[0][b], p.v[1][b], D == 3 ? p.v[D - 1][b] : 0.0f,
+                           p.vv[0][b], p.vv[1][b], D == 3 ? p.vv[D - 1][b] : 0.0f,
+                           p.pressure[b], p.inverse_density[b], p.excess[b], p.fluid[b]};
         if constexpr (Masked) {
           if (block_near || filter.is_near(b)) {
             // Pairs beyond the support have no weight anyway: ask only about the others.
             for (int i = 0; i < n; ++i) {
-              const float dx = xa[0][i] - xb, dy = xa[1][i] - yb, dz = D == 3 ? xa[2][i] - zb : 0.0f;
+              const float dx = L.x[0][i] - nb.x, dy = L.x[1][i] - nb.y, dz = D == 3 ? L.x[2][i] - nb.z : 0.0f;
               const bool inside = dx * dx + dy * dy + dz * dz < k.support2;
-              keep[i] = inside && filter.blocked(block + static_cast<std::uint32_t>(i), b) ? 0.0f : 1.0f;
+              L.keep[i] = inside && filter.blocked(lane_index[i], b) ? 0.0f : 1.0f;
             }
             keep_dirty = true;
           } else if (keep_dirty) {
-            for (int i = 0; i < n; ++i) keep[i] = 1.0f;
+            for (int i = 0; i < n; ++i) L.keep[i] = 1.0f;
             keep_dirty = false;
           }
         }
-#pragma omp simd aligned(xa, va, wa, pa, inva, exa, acc, cont, diff, csum, cg, keep : 64)
+        if constexpr (Bodies) {
+          if (booking.books(particles, b)) {
+            const unsigned body = particles.body[b];
+            if (!(booked_bodies & (1u << body))) {
+              for (int d = 0; d < 3; ++d)
+                for (int i = 0; i < kBlock; ++i) L.booked[body][d][i] = 0.0f;
+              booked_bodies |= 1u << body;
+            }
+            add_neighbour<D, WithArtificialViscosity, WithKernelSum, Masked, true>(L, nb, padded, k, W, &L.booked[body][0][0]);
+            continue;
+          }
+        }
+        add_neighbour<D, WithArtificialViscosity, WithKernelSum, Masked, false>(L, nb, padded, k, W, nullptr);
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      const std::uint32_t a = lane_index[i];
+      if (particles.kind[a] != Kind::fluid) continue;
+      for (int d = 0; d < D; ++d) particles.acceleration[d][a] = k.mass * L.acc[d][i] + k.gravity[d];
+      particles.density_rate[a] = k.mass * (L.cont[i] + k.diffusion * L.diff[i]);
+      if constexpr (WithKernelSum) {
+        particles.kernel_sum[a] = k.mass * L.csum[i];
+        for (int d = 0; d < D; ++d) particles.kernel_sum_gradient[d][a] = k.mass * L.cg[d][i];
+      }
+    }
+    if constexpr (Bodies) {
+      // Force on the body = - m_a m_b (the lanes' pair accelerations from its walls).
+      for (unsigned body = 0; booked_bodies >> body; ++body) {
+        if (!(booked_bodies & (1u << body))) continue;
+        for (int d = 0; d < D; ++d) {
+          float sum = 0.0f;
+          for (int i = 0; i < n; ++i) sum += L.booked[body][d][i];
+          booking.thread_forces[body * D + d] -= static_cast<double>(k.mass) * k.mass * sum;
+        }
+      }
+    }
+  }
+}
+
+// Per-lane sums of the generalized wall condition for one block of a cell's particles.
+struct alignas(64) WallLanes {
+  alignas(64) float x[3][kBlock], keep[kBlock];
+  alignas(64) float sum_w[kBlock], sum_p[kBlock], sum_rho_r[3][kBlock], sum_v[3][kBlock];
+};
+
+// Sums over the fluid neighbours of every wall lane of one cell (SIMD over the lanes, each
+// fluid neighbour broadcast, as in cell_block_rates), then sets the lanes' wall state.
+template <int D, bool Masked, class Kernel>
+[[gnu::noinline]] void cell_block_wall_state(Particles<D>& particles, const ParticleView<D>& p, const FluidSettings<D>& s,
+                                             const LinearMieGruneisen& eos, const Kernel& W, const std::uint32_t* lane_index,
+                                             int n, const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments,
+                                             int segment_count, const PairFilter<D>& filter,
+                                             const std::vector<Vec<D>>& body_acceleration, float support2, WallLanes& L) {
+  const float rho0 = static_cast<float>(s.rest_density);
+  {
+    const int padded = (n + kLanes - 1) / kLanes * kLanes;
+    bool block_near = false;
+    if constexpr (Masked) {
+      for (int i = 0; i < kBlock; ++i) L.keep[i] = 1.0f;
+      for (int i = 0; i < n; ++i) block_near = block_near || filter.is_near(lane_index[i]);
+    }
+    bool keep_dirty = false;
+    bool any_wall = false;  // a lane that is a wall, not an image
+    for (int i = 0; i < padded; ++i) {
+      const bool real = i < n;
+      const std::uint32_t a = lane_index[real ? i : 0];
+      for (int d = 0; d < 3; ++d) {
+        L.x[d][i] = d < D ? (real ? p.x[d][a] : 1e15f) : 0.0f;
+        L.sum_rho_r[d][i] = L.sum_v[d][i] = 0.0f;
+      }
+      L.sum_w[i] = L.sum_p[i] = 0.0f;
+      any_wall = any_wall || (real && p.kind[a] == Kind::wall);
+    }
+    float box_lo[3] = {0, 0, 0}, box_hi[3] = {0, 0, 0};
+    lane_box<D>(L.x, n, box_lo, box_hi);
+    for (int sidx = 0; sidx < segment_count; ++sidx) {
+      const auto& seg = segments[sidx];
+      float shift[3] = {0, 0, 0};
+      for (int d = 0; d < D; ++d) shift[d] = static_cast<float>(seg.shift[d]);
+      for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
+        if (p.fluid[b] == 0.0f) continue;  // only fluid (and its mirror images) is extrapolated
+        const float xb = p.x[0][b] + shift[0], yb = p.x[1][b] + shift[1], zb = D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f;
+        if (!near_box<D>(box_lo, box_hi, xb, yb, zb, support2)) continue;
+        // Mirror fluid near a wall takes a lane in the rates pass, to book its push on the wall.
+        if (any_wall && p.kind[b] == Kind::mirror_fluid) __atomic_store_n(&particles.near_wall[b], std::uint8_t{1}, __ATOMIC_RELAXED);
+        const float rho_b = rho0 + p.excess[b], p_b = p.pressure[b];
+        const float vxb = p.v[0][b], vyb = p.v[1][b], vzb = D == 3 ? p.v[D - 1][b] : 0.0f;
+        if constexpr (Masked) {
+          if (block_near || filter.is_near(b)) {
+            for (int i = 0; i < n; ++i) {
+              const float dx = L.x[0][i] - xb, dy = L.x[1][i] - yb, dz = D == 3 ? L.x[2][i] - zb : 0.0f;
+              const bool inside = dx * dx + dy * dy + dz * dz < support2;
+              L.keep[i] = inside && filter.blocked(lane_index[i], b) ? 0.0f : 1.0f;
+            }
+            keep_dirty = true;
+          } else if (keep_dirty) {
+            for (int i = 0; i < n; ++i) L.keep[i] = 1.0f;
+            keep_dirty = false;
+          }
+        }
+#pragma omp simd simdlen(8)
         for (int i = 0; i < padded; ++i) {
-          const float dx = xa[0][i] - xb, dy = xa[1][i] - yb, dz = D == 3 ? xa[2][i] - zb : 0.0f;
-          const float r2 = dx * dx + dy * dy + dz * dz;
-          const float r = std::sqrt(r2);
-          float F = W.gradient_factor(r);
-          if constexpr (Masked) F *= keep[i];
-          const float inv_rr = inva[i] * inv_b;
-          const float vdx = (va[0][i] - vxb) * dx + (va[1][i] - vyb) * dy + (D == 3 ? (va[2][i] - vzb) * dz : 0.0f);
-          cont[i] += vdx * F;
-          // Against a wall only the fluid's positive pressure counts: walls push, never pull
-          // (a tensile surge tip would otherwise be sucked into the wall it hits).
-          const float pa_wall = std::max(pa[i], 0.0f);
-          float radial = -(p_b + pa_wall + is_fluid * (pa[i] - pa_wall)) * inv_rr;
-          if constexpr (WithArtificialViscosity) {
-            const float mu_ab = k.h * std::min(vdx, 0.0f) / (r2 + k.eta2);
-            radial += k.alpha_c0 * mu_ab * 0.5f * (inva[i] + inv_b);
-          }
-          radial *= F;
-          const float viscous = k.two_mu * inv_rr * F;
-          acc[0][i] += radial * dx + viscous * (wa[0][i] - wxb);
-          acc[1][i] += radial * dy + viscous * (wa[1][i] - wyb);
-          if constexpr (D == 3) acc[2][i] += radial * dz + viscous * (wa[2][i] - wzb);
-          float g_dot_rba = -(k.gravity[0] * dx + k.gravity[1] * dy);
-          if constexpr (D == 3) g_dot_rba -= k.gravity[D - 1] * dz;
-          diff[i] += is_fluid * (ex_b - exa[i] - k.hydrostatic * g_dot_rba) * (-F) * inv_b;
-          if constexpr (WithKernelSum) {
-            csum[i] += W.value(r) * (Masked ? keep[i] : 1.0f) * inv_b;
-            cg[0][i] += F * dx * inv_b;
-            cg[1][i] += F * dy * inv_b;
-            if constexpr (D == 3) cg[2][i] += F * dz * inv_b;
-          }
+          const float dx = L.x[0][i] - xb, dy = L.x[1][i] - yb, dz = D == 3 ? L.x[2][i] - zb : 0.0f;
+          float wk = W.value(std::sqrt(dx * dx + dy * dy + dz * dz));
+          if constexpr (Masked) wk *= L.keep[i];
+          L.sum_w[i] += wk;
+          L.sum_p[i] += p_b * wk;
+          L.sum_rho_r[0][i] += rho_b * dx * wk;
+          L.sum_rho_r[1][i] += rho_b * dy * wk;
+          if constexpr (D == 3) L.sum_rho_r[2][i] += rho_b * dz * wk;
+          L.sum_v[0][i] += vxb * wk;
+          L.sum_v[1][i] += vyb * wk;
+          if constexpr (D == 3) L.sum_v[2][i] += vzb * wk;
         }
       }
     }
     for (int i = 0; i < n; ++i) {
-      const std::uint32_t a = block + static_cast<std::uint32_t>(i);
-      if (particles.kind[a] != Kind::fluid) continue;
-      for (int d = 0; d < D; ++d) particles.acceleration[d][a] = k.mass * acc[d][i] + k.gravity[d];
-      particles.density_rate[a] = k.mass * (cont[i] + k.diffusion * diff[i]);
-      if constexpr (WithKernelSum) {
-        particles.kernel_sum[a] = k.mass * csum[i];
-        for (int d = 0; d < D; ++d) particles.kernel_sum_gradient[d][a] = k.mass * cg[d][i];
+      const std::uint32_t w = lane_index[i];
+      if (particles.kind[w] != Kind::wall && particles.kind[w] != Kind::mirror_wall) continue;
+      // Adami et al. 2012, eq. 27: p_w = (sum p_f W + (g - a_w) . sum rho_f r_wf W) / sum W;
+      // no-slip by the extrapolated velocity, v_w^visc = 2 v_w - v~ (their eq. 22-23).
+      const auto& a_w = body_acceleration[particles.body[w]];
+      const float sum_w = L.sum_w[i];
+      particles.near_fluid[w] = sum_w > 0.0f;
+      if (sum_w > 0.0f) {
+        double pw = L.sum_p[i];
+        for (int d = 0; d < D; ++d) pw += (s.gravity[d] - a_w[d]) * L.sum_rho_r[d][i];
+        // A wall pushes but never pulls: absolute pressure (with the background) below zero
+        // would suck fluid into the wall where a free surface runs along it.
+        pw = std::max(pw / sum_w, 0.0);
+        particles.pressure[w] = static_cast<float>(pw);
+        const double excess = eos.density_excess(pw - s.background_pressure);
+        particles.density_excess[w] = static_cast<float>(excess);
+        particles.inverse_density[w] = static_cast<float>(1.0 / (s.rest_density + excess));
+        for (int d = 0; d < D; ++d) particles.viscous_velocity[d][w] = 2.0f * particles.velocity[d][w] - L.sum_v[d][i] / sum_w;
+      } else {
+        particles.pressure[w] = static_cast<float>(s.background_pressure);
+        particles.density_excess[w] = 0.0f;
+        particles.inverse_density[w] = 1.0f / rho0;
+        for (int d = 0; d < D; ++d) particles.viscous_velocity[d][w] = particles.velocity[d][w];
       }
     }
   }
@@ -295,63 +498,27 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
                        const std::vector<Vec<D>>& body_acceleration, const PairFilter<D>& filter) {
   const LinearMieGruneisen eos{s.rest_density, s.sound_speed};
   const ParticleView<D> view(p);
-  const float rho0 = static_cast<float>(s.rest_density);
+  const float support2 = static_cast<float>(s.support_radius() * s.support_radius());
+  std::fill(p.near_wall.begin(), p.near_wall.end(), std::uint8_t{0});
   with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
-    for_each_particle_with_neighbours<D>(grid, [&](std::uint32_t w, const auto& segments, int count) {
-      if (p.kind[w] != Kind::wall && p.kind[w] != Kind::mirror_wall) return;
-      float sum_w = 0, sum_p = 0;
-      float sum_rho_r[3] = {0, 0, 0}, sum_v[3] = {0, 0, 0};
-      for (int sidx = 0; sidx < count; ++sidx) {
-        const auto& seg = segments[sidx];
-        float xw[3] = {0, 0, 0};
-        for (int d = 0; d < D; ++d) xw[d] = view.x[d][w] - static_cast<float>(seg.shift[d]);
-        for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
-          if (!acts_as_fluid(view.kind[b])) continue;
-          if (filter.active() && filter.blocked(w, b)) continue;
-          float dx[3] = {0, 0, 0};
-          float r2 = 0;
-          for (int d = 0; d < D; ++d) {
-            dx[d] = xw[d] - view.x[d][b];
-            r2 += dx[d] * dx[d];
-          }
-          const float wk = W.value(std::sqrt(r2));
-          if (wk <= 0.0f) continue;
-          const float rho_b = rho0 + view.excess[b];
-          sum_w += wk;
-          sum_p += view.pressure[b] * wk;
-          for (int d = 0; d < D; ++d) {
-            sum_rho_r[d] += rho_b * dx[d] * wk;
-            sum_v[d] += view.v[d][b] * wk;
-          }
-        }
-      }
-      // Adami et al. 2012, eq. 27: p_w = (sum p_f W + (g - a_w) . sum rho_f r_wf W) / sum W;
-      // no-slip by the extrapolated velocity, v_w^visc = 2 v_w - v~ (their eq. 22-23).
-      const auto& a_w = body_acceleration[p.body[w]];
-      p.near_fluid[w] = sum_w > 0.0f;
-      if (sum_w > 0.0f) {
-        double pw = sum_p;
-        for (int d = 0; d < D; ++d) pw += (s.gravity[d] - a_w[d]) * sum_rho_r[d];
-        // A wall pushes but never pulls: absolute pressure (with the background) below zero
-        // would suck fluid into the wall where a free surface runs along it.
-        pw = std::max(pw / sum_w, 0.0);
-        p.pressure[w] = static_cast<float>(pw);
-        const double excess = eos.density_excess(pw - s.background_pressure);
-        p.density_excess[w] = static_cast<float>(excess);
-        p.inverse_density[w] = static_cast<float>(1.0 / (s.rest_density + excess));
-        for (int d = 0; d < D; ++d) p.viscous_velocity[d][w] = 2.0f * p.velocity[d][w] - sum_v[d] / sum_w;
-      } else {
-        p.pressure[w] = static_cast<float>(s.background_pressure);
-        p.density_excess[w] = 0.0f;
-        p.inverse_density[w] = 1.0f / rho0;
-        for (int d = 0; d < D; ++d) p.viscous_velocity[d][w] = p.velocity[d][w];
-      }
-    });
+#pragma omp parallel
+    {
+      WallLanes lanes;
+      for_each_lane_block<D, kBlock>(
+          grid, [&](std::uint32_t a) { return p.kind[a] == Kind::wall || p.kind[a] == Kind::mirror_wall; },
+          [&](const std::uint32_t* lane_index, int n, const auto& segments, int count) {
+            if (filter.touches(segments, count))
+              cell_block_wall_state<D, true>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, lanes);
+            else
+              cell_block_wall_state<D, false>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, lanes);
+          });
+    }
   });
 }
 
 template <int D>
-void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s, const PairFilter<D>& filter) {
+void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s, const PairFilter<D>& filter,
+                         std::vector<Vec<D>>* body_forces, bool include_fixed_walls) {
   const PairConstants<D> k(s);
   const ParticleView<D> view(p);
   const bool shifting = s.shifting > 0;
@@ -359,24 +526,37 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
     p.kernel_sum.resize(p.size());
     for (int d = 0; d < D; ++d) p.kernel_sum_gradient[d].resize(p.size());
   }
-  const auto cells = static_cast<std::ptrdiff_t>(grid.cell_count());
-  with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
+  const int body_count = body_forces != nullptr ? static_cast<int>(body_forces->size()) : 0;
+  if (body_count > kMaxBookedBodies) {
+    // Too many bodies to book in the pair loop: the separate pass over the wall particles.
+    compute_fluid_rates<D>(p, grid, s, filter);
+    *body_forces = compute_body_forces<D>(p, grid, s, static_cast<std::size_t>(body_count), include_fixed_walls, filter);
+    return;
+  }
+  const int threads = omp_get_max_threads();
+  std::vector<double> per_thread(static_cast<std::size_t>(threads) * static_cast<std::size_t>(std::max(body_count, 1)) * D, 0.0);
+    with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
 #pragma omp parallel
     {
-      std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)> segments;
-#pragma omp for schedule(dynamic, 16)
-      for (std::ptrdiff_t c = 0; c < cells; ++c) {
-        const std::uint32_t first = grid.cell_start(static_cast<std::size_t>(c));
-        const std::uint32_t last = grid.cell_start(static_cast<std::size_t>(c) + 1);
-        if (first == last) continue;
-        bool any_fluid = false;
-        for (std::uint32_t a = first; a < last && !any_fluid; ++a) any_fluid = p.kind[a] == Kind::fluid;
-        if (!any_fluid) continue;
-        const int count = grid.neighbour_segments(static_cast<std::size_t>(c), segments);
+      LaneBlock lanes;
+      BodyBooking<D> booking;
+      booking.body_count = body_count;
+      booking.include_fixed = include_fixed_walls;
+      booking.thread_forces = per_thread.data() + static_cast<std::size_t>(omp_get_thread_num()) * static_cast<std::size_t>(std::max(body_count, 1)) * D;
+      // Rates are needed for the fluid; booked reactions also where mirror fluid meets a wall.
+      auto wanted = [&](std::uint32_t a) {
+        return p.kind[a] == Kind::fluid || (body_count > 0 && p.kind[a] == Kind::mirror_fluid && p.near_wall[a] != 0);
+      };
+      for_each_lane_block<D, kBlock>(grid, wanted, [&](const std::uint32_t* lane_index, int n, const auto& segments, int count) {
         const bool masked = filter.touches(segments, count);
         auto run = [&]<bool AV, bool KS>() {
-          if (masked) cell_block_rates<D, AV, KS, true>(p, view, k, W, first, last, segments, count, filter);
-          else cell_block_rates<D, AV, KS, false>(p, view, k, W, first, last, segments, count, filter);
+          if (body_count > 0) {
+            if (masked) cell_block_rates<D, AV, KS, true, true>(p, view, k, W, lane_index, n, segments, count, filter, lanes, booking);
+            else cell_block_rates<D, AV, KS, false, true>(p, view, k, W, lane_index, n, segments, count, filter, lanes, booking);
+          } else {
+            if (masked) cell_block_rates<D, AV, KS, true, false>(p, view, k, W, lane_index, n, segments, count, filter, lanes, booking);
+            else cell_block_rates<D, AV, KS, false, false>(p, view, k, W, lane_index, n, segments, count, filter, lanes, booking);
+          }
         };
         if (k.alpha_c0 > 0) {
           if (shifting) run.template operator()<true, true>();
@@ -385,9 +565,14 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
           if (shifting) run.template operator()<false, true>();
           else run.template operator()<false, false>();
         }
-      }
+      });
     }
   });
+  if (body_count == 0) return;
+  body_forces->assign(static_cast<std::size_t>(body_count), Vec<D>{});
+  for (int t = 0; t < threads; ++t)
+    for (int b = 0; b < body_count; ++b)
+      for (int d = 0; d < D; ++d) (*body_forces)[b][d] += per_thread[(static_cast<std::size_t>(t) * body_count + b) * D + d];
 }
 
 template <int D>
@@ -423,8 +608,8 @@ template void update_fluid_pressure<2>(Particles<2>&, const FluidSettings<2>&);
 template void update_fluid_pressure<3>(Particles<3>&, const FluidSettings<3>&);
 template void update_wall_state<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, const std::vector<Vec<2>>&, const PairFilter<2>&);
 template void update_wall_state<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, const std::vector<Vec<3>>&, const PairFilter<3>&);
-template void compute_fluid_rates<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, const PairFilter<2>&);
-template void compute_fluid_rates<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, const PairFilter<3>&);
+template void compute_fluid_rates<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, const PairFilter<2>&, std::vector<Vec<2>>*, bool);
+template void compute_fluid_rates<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, const PairFilter<3>&, std::vector<Vec<3>>*, bool);
 template std::vector<Vec<2>> compute_body_forces<2>(const Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, std::size_t, bool, const PairFilter<2>&);
 template std::vector<Vec<3>> compute_body_forces<3>(const Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, std::size_t, bool, const PairFilter<3>&);
 

@@ -46,7 +46,13 @@ class CellGrid {
   std::size_t cell_of(const Particles<D>& particles, std::size_t i) const;
 
   // Up to 3^(D-1) * 3 segments covering the cell's neighbour cells; returns how many.
-  int neighbour_segments(std::size_t cell, std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& out) const;
+  int neighbour_segments(std::size_t cell, std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& out) const {
+    return neighbour_segments(cell, cell, out);
+  }
+  // The same for the cells first_cell..last_cell of one row along x (last_cell >= first_cell,
+  // same row): the neighbour rows span x from first - 1 to last + 1.
+  int neighbour_segments(std::size_t first_cell, std::size_t last_cell,
+                         std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& out) const;
 
  private:
   Vec<D> lower_{}, upper_{}, size_{}, inv_size_{};

@@ -80,6 +80,7 @@ class FluidSolver {
   std::vector<Vec<D>> body_acceleration_;
   bool body_forces_requested_ = false;
   bool body_forces_always_ = false;
+  std::vector<std::uint32_t> mirror_keep_;  // scratch of refresh_mirror_images
   double time_ = 0.0;
   double dt_ = 0.0;
   long steps_ = 0;

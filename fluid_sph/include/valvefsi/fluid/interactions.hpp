@@ -26,10 +26,17 @@ template <int D>
 void update_wall_state(Particles<D>& particles, const CellGrid<D>& grid, const FluidSettings<D>& settings,
                        const std::vector<Vec<D>>& body_acceleration, const PairFilter<D>& filter = {});
 
+// With body_forces (its size the body count), also the force (N; per unit depth in 2D) of the
+// fluid on each body 0..size-1, the fixed walls (body 0) only if include_fixed_walls: booked
+// in the same pair loop as the reaction of the fluid-wall pair terms (they are
+// antisymmetric), so no second pass over the walls; equal to compute_body_forces to round-off.
 template <int D>
 void compute_fluid_rates(Particles<D>& particles, const CellGrid<D>& grid, const FluidSettings<D>& settings,
-                         const PairFilter<D>& filter = {});
+                         const PairFilter<D>& filter = {}, std::vector<Vec<D>>* body_forces = nullptr,
+                         bool include_fixed_walls = false);
 
+// The same forces by a pass of its own over the wall particles (the reference the booked
+// forces are tested against; used when there are too many bodies to book).
 // Force (N; per unit depth in 2D) of the fluid on each body 0..body_count-1; the fixed walls
 // (body 0) only if include_fixed_walls (they are usually most of the dummy particles).
 // Only wall particles with fluid in their kernel (update_wall_state marks them) are visited.

@@ -50,6 +50,7 @@ struct Particles {
   std::vector<float> fluid_mask;
   std::vector<float> inverse_density;  // 1 / rho, set with the pressure each evaluation
   std::vector<std::uint8_t> near_fluid;  // walls: 1 if a fluid particle is within the support
+  std::vector<std::uint8_t> near_wall;   // mirror fluid: 1 if a wall (not an image) may be within the support
   std::vector<float> kernel_sum;                          // C = sum_b V_b W_ab (shifting only)
   std::array<std::vector<float>, D> kernel_sum_gradient;  // grad C (shifting only)
 

@@ -56,7 +56,8 @@ def cheapest_within(rows: list[dict], finest: dict | None, tolerance: float) -> 
     if finest is None:
         return None
     needed = [m for m in metrics_module.HEADLINE if finest["metrics"].get(m) is not None]
-    good = [r for r in rows if usable(r) and all(m in r["errors"] and abs(r["errors"][m]) <= tolerance for m in needed)]
+    good = [r for r in rows if usable(r) and r["label"] != finest["label"]
+            and all(m in r["errors"] and abs(r["errors"][m]) <= tolerance for m in needed)]
     return min(good, key=lambda r: r["cost"]["cpu_s"]) if good else None
 
 
@@ -122,7 +123,8 @@ def markdown(results: list[dict], finest_label: str | None = None, tolerance: fl
     if finest is None:
         lines.append("No finest run completed: no errors computed.")
     elif best is None:
-        lines.append(f"No run is within {100 * tolerance:g} % of the finest ({finest['label']}) on every headline metric.")
+        lines.append(f"No cheaper run is within {100 * tolerance:g} % of the finest ({finest['label']}) on every "
+                     "headline metric it has: the finest is the only setting that qualifies.")
     else:
         needed = [m for m in metrics_module.HEADLINE if finest["metrics"].get(m) is not None]
         lines.append(f"Cheapest setting within {100 * tolerance:g} % of the finest ({finest['label']}) on every "
@@ -143,10 +145,14 @@ def chart(results: list[dict], path: Path, finest_label: str | None = None, titl
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.8))
     floor = 1e-3   # errors below 0.1 % are drawn at 0.1 %
     varied = axes_of(results)
+    from .stability import KIND_COLOURS
     for ax, key in ((axes[0], "wall_s"), (axes[1], "cpu_s")):
+        shown_kinds = set()
         for r in rows:
             x, y = r["cost"][key], max(r["max_error"], floor)
-            ax.loglog(x, y, "o", color="tab:blue")
+            kind = r["outcome"]["kind"]
+            ax.loglog(x, y, "o", color=KIND_COLOURS.get(kind, "black"), label=None if kind in shown_kinds else kind)
+            shown_kinds.add(kind)
             ax.annotate(", ".join(_short(v) for k, v in r["setting"].items() if k in varied), (x, y), fontsize=7,
                         xytext=(3, 3), textcoords="offset points")
     markers = dict(zip(metrics_module.HEADLINE, "os^vD<>"))
@@ -166,6 +172,8 @@ def chart(results: list[dict], path: Path, finest_label: str | None = None, titl
         ax.grid(True, which="both", alpha=0.3)
     if plotted:
         axes[2].legend(fontsize=8)
+    if rows:
+        axes[0].legend(fontsize=8, title="run ended", title_fontsize=8)
     fig.suptitle(title or (f"cost against error, finest = {finest['label']}" if finest else "cost against error"),
                  fontsize=9)
     fig.tight_layout()

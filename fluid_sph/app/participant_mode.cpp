@@ -17,43 +17,42 @@
 #include "valvefsi/fluid/case_setup.hpp"
 #ifdef VALVEFSI_FLUID_HAS_THIN_WALL
 #include "valvefsi/fluid/thin_wall/thin_wall_model.hpp"
+#include "valvefsi/fluid/thin_wall/thin_wall_model_3d.hpp"
 #endif
 
 namespace valvefsi::fluid::app {
 namespace {
 
-// The surface model for the solid's interface; throws std::invalid_argument naming what is
-// missing when the fluid cannot represent this surface.
+// The surface model for the solid's interface (the two-sided thin wall: segments in 2D,
+// triangles in 3D); throws std::invalid_argument naming what is missing when the fluid cannot
+// represent this surface.
 template <int D>
 std::unique_ptr<ImmersedSurfaceModel<D>> surface_model(const coupling::InterfaceSurfaceData& surface,
                                                        const FluidSettings<D>& settings, const cases::Case& c,
                                                        const std::filesystem::path& case_file) {
-  if constexpr (D == 3) {
-    (void)surface, (void)settings, (void)c;
-    throw std::invalid_argument(case_file.string() + ": run.dimension = 3: fluid_sph has no 3D immersed-surface model yet "
-                                "(the two-sided thin wall exists for 2D segments only; the 3D triangle version is not "
-                                "built), so it cannot couple to a 3D solid surface; run a 2D case (run.dimension: 2)");
-  } else {
 #ifndef VALVEFSI_FLUID_HAS_THIN_WALL
-    (void)surface, (void)settings, (void)c;
-    throw std::invalid_argument(case_file.string() + ": fluid_sph was built without the thin-wall model "
-                                "(fluid_sph/thin_wall), which couples a 2D leaflet surface");
+  (void)surface, (void)settings, (void)c;
+  throw std::invalid_argument(case_file.string() + ": fluid_sph was built without the thin-wall model "
+                              "(fluid_sph/thin_wall), which couples a leaflet surface");
 #else
-    if (surface.nodes_per_cell != 2)
-      throw std::invalid_argument(fmt::format("{}: the solid's interface has {} nodes per cell; a 2D fluid needs segments (2)",
-                                              case_file.string(), surface.nodes_per_cell));
-    ImmersedSurfaceGeometry<2> geometry;
-    const auto n = static_cast<std::size_t>(surface.positions.cols());
-    geometry.nodes.resize(n);
-    for (std::size_t j = 0; j < n; ++j) geometry.nodes[j] = {surface.positions(0, j), surface.positions(1, j)};
-    geometry.nodes_per_cell = 2;
-    geometry.cells.reserve(static_cast<std::size_t>(surface.cells.size()));
-    for (Eigen::Index cell = 0; cell < surface.cells.cols(); ++cell)
-      for (Eigen::Index k = 0; k < 2; ++k) geometry.cells.push_back(static_cast<std::uint32_t>(surface.cells(k, cell)));
-    geometry.node_thickness.assign(surface.node_thickness.data(), surface.node_thickness.data() + surface.node_thickness.size());
+  if (surface.nodes_per_cell != D)
+    throw std::invalid_argument(fmt::format("{}: the solid's interface has {} nodes per cell; a {}D fluid needs {} ({})",
+                                            case_file.string(), surface.nodes_per_cell, D, D, D == 2 ? "segments" : "triangles"));
+  ImmersedSurfaceGeometry<D> geometry;
+  const auto n = static_cast<std::size_t>(surface.positions.cols());
+  geometry.nodes.resize(n);
+  for (std::size_t j = 0; j < n; ++j)
+    for (int d = 0; d < D; ++d) geometry.nodes[j][static_cast<std::size_t>(d)] = surface.positions(d, static_cast<Eigen::Index>(j));
+  geometry.nodes_per_cell = D;
+  geometry.cells.reserve(static_cast<std::size_t>(surface.cells.size()));
+  for (Eigen::Index cell = 0; cell < surface.cells.cols(); ++cell)
+    for (Eigen::Index k = 0; k < D; ++k) geometry.cells.push_back(static_cast<std::uint32_t>(surface.cells(k, cell)));
+  geometry.node_thickness.assign(surface.node_thickness.data(), surface.node_thickness.data() + surface.node_thickness.size());
+  if constexpr (D == 2)
     return thin_wall::make_thin_wall_model_2d(geometry, settings, c.fluid().thin_walls());
+  else
+    return thin_wall::make_thin_wall_model_3d(geometry, settings, c.fluid().thin_walls());
 #endif
-  }
 }
 
 template <int D>

@@ -69,27 +69,39 @@ void TriangleMesh::update() {
   vertex_on_boundary.assign(position.size(), false);
   edge_normal.assign(triangles.size(), {});
   edge_on_boundary.assign(triangles.size(), {});
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::pair<std::size_t, int>>> edges;
+  if (edges_for_ != triangles.size()) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> index;
+    edges_.clear();
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t i = triangles[t][static_cast<std::size_t>(k)], j = triangles[t][static_cast<std::size_t>((k + 1) % 3)];
+        const auto key = std::make_pair(std::min(i, j), std::max(i, j));
+        auto [it, inserted] = index.try_emplace(key, edges_.size());
+        if (inserted) edges_.push_back(Edge{key.first, key.second, {}});
+        edges_[it->second].users.push_back({static_cast<std::uint32_t>(t), k});
+      }
+    edges_for_ = triangles.size();
+  }
+  std::vector<Vec3> face(triangles.size());
   for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const Vec3 n = face_normal(t);
+    face[t] = face_normal(t);
     for (int k = 0; k < 3; ++k) {
-      const std::uint32_t i = triangles[t][static_cast<std::size_t>(k)], j = triangles[t][static_cast<std::size_t>((k + 1) % 3)];
-      edges[{std::min(i, j), std::max(i, j)}].push_back({t, k});
+      const std::uint32_t i = triangles[t][static_cast<std::size_t>(k)];
       // Angle of the triangle at corner k weights its normal at that vertex.
       const Vec3 u = sub(corner(*this, t, (k + 1) % 3), corner(*this, t, k));
       const Vec3 v = sub(corner(*this, t, (k + 2) % 3), corner(*this, t, k));
       const double angle = std::acos(std::clamp(dot(u, v) / (norm(u) * norm(v)), -1.0, 1.0));
-      vertex_normal[i] = add(vertex_normal[i], scale(n, angle));
+      vertex_normal[i] = add(vertex_normal[i], scale(face[t], angle));
     }
   }
-  for (const auto& [key, users] : edges) {
+  for (const Edge& e : edges_) {
     Vec3 sum{0, 0, 0};
-    for (const auto& [t, k] : users) sum = add(sum, face_normal(t));
-    for (const auto& [t, k] : users) {
+    for (const auto& [t, k] : e.users) sum = add(sum, face[t]);
+    for (const auto& [t, k] : e.users) {
       edge_normal[t][static_cast<std::size_t>(k)] = sum;
-      edge_on_boundary[t][static_cast<std::size_t>(k)] = users.size() == 1;
+      edge_on_boundary[t][static_cast<std::size_t>(k)] = e.users.size() == 1;
     }
-    if (users.size() == 1) vertex_on_boundary[key.first] = vertex_on_boundary[key.second] = true;
+    if (e.users.size() == 1) vertex_on_boundary[e.first] = vertex_on_boundary[e.second] = true;
   }
 }
 
@@ -133,36 +145,66 @@ ClosestPoint3 closest_point(const TriangleMesh& mesh, const Vec3& x) {
   return closest_point(mesh, all, x);
 }
 
-std::optional<Crossing3> first_crossing(const TriangleMesh& mesh, const Vec3& p, const Vec3& q) {
-  // Moller & Trumbore (1997) per triangle; a segment in a triangle's plane does not cross it.
+namespace {
+
+// Moller & Trumbore (1997) for triangle t; a segment in the triangle's plane does not cross it.
+bool segment_meets_triangle(const TriangleMesh& mesh, std::size_t t, const Vec3& p, const Vec3& d, double d_norm,
+                            Crossing3& hit) {
+  constexpr double tol = 1e-12;
+  const Vec3 a = corner(mesh, t, 0);
+  const Vec3 e1 = sub(corner(mesh, t, 1), a), e2 = sub(corner(mesh, t, 2), a);
+  const Vec3 h = cross(d, e2);
+  const double det = dot(e1, h);
+  if (std::abs(det) <= 1e-14 * d_norm * norm(e1) * norm(e2)) return false;
+  const double f = 1.0 / det;
+  const Vec3 s = sub(p, a);
+  const double u = f * dot(s, h);
+  if (u < -tol || u > 1 + tol) return false;
+  const Vec3 qv = cross(s, e1);
+  const double v = f * dot(d, qv);
+  if (v < -tol || u + v > 1 + tol) return false;
+  const double along = f * dot(e2, qv);
+  if (along < -tol || along > 1 + tol) return false;
+  hit = Crossing3{t, along, {1 - u - v, u, v}};
+  return true;
+}
+
+}  // namespace
+
+std::optional<Crossing3> first_crossing(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles, const Vec3& p,
+                                        const Vec3& q) {
   std::optional<Crossing3> best;
   const Vec3 d = sub(q, p);
-  constexpr double tol = 1e-12;
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const Vec3 a = corner(mesh, t, 0);
-    const Vec3 e1 = sub(corner(mesh, t, 1), a), e2 = sub(corner(mesh, t, 2), a);
-    const Vec3 h = cross(d, e2);
-    const double det = dot(e1, h);
-    if (std::abs(det) <= 1e-14 * norm(d) * norm(e1) * norm(e2)) continue;
-    const double f = 1.0 / det;
-    const Vec3 s = sub(p, a);
-    const double u = f * dot(s, h);
-    if (u < -tol || u > 1 + tol) continue;
-    const Vec3 qv = cross(s, e1);
-    const double v = f * dot(d, qv);
-    if (v < -tol || u + v > 1 + tol) continue;
-    const double along = f * dot(e2, qv);
-    if (along < -tol || along > 1 + tol) continue;
-    if (!best || along < best->s) best = Crossing3{t, along};
-  }
+  const double dn = norm(d);
+  Crossing3 hit;
+  for (const std::uint32_t t : triangles)
+    if (segment_meets_triangle(mesh, t, p, d, dn, hit) && (!best || hit.s < best->s)) best = hit;
+  return best;
+}
+
+std::optional<Crossing3> first_crossing(const TriangleMesh& mesh, const Vec3& p, const Vec3& q) {
+  std::optional<Crossing3> best;
+  const Vec3 d = sub(q, p);
+  const double dn = norm(d);
+  Crossing3 hit;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    if (segment_meets_triangle(mesh, t, p, d, dn, hit) && (!best || hit.s < best->s)) best = hit;
   return best;
 }
 
 std::optional<SweptCrossing3> swept_crossing(const TriangleMesh& mesh, const std::vector<Vec3>& before,
                                              const std::vector<Vec3>& after, const Vec3& x0, const Vec3& x1) {
+  std::vector<std::uint32_t> all(mesh.triangles.size());
+  for (std::size_t t = 0; t < all.size(); ++t) all[t] = static_cast<std::uint32_t>(t);
+  return swept_crossing(mesh, all, before, after, x0, x1);
+}
+
+std::optional<SweptCrossing3> swept_crossing(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles,
+                                             const std::vector<Vec3>& before, const std::vector<Vec3>& after, const Vec3& x0,
+                                             const Vec3& x1) {
   std::vector<SweptCrossing3> events;
   const Vec3 dx = sub(x1, x0);
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+  for (const std::uint32_t t : triangles) {
     const auto& tri = mesh.triangles[t];
     const Vec3 a0 = before[tri[0]], da = sub(after[tri[0]], a0);
     const Vec3 e1 = sub(before[tri[1]], a0), de1 = sub(sub(after[tri[1]], before[tri[1]]), da);
@@ -214,6 +256,103 @@ std::optional<SweptCrossing3> swept_crossing(const TriangleMesh& mesh, const std
     if (unique.empty() || e.tau - unique.back().tau > 1e-9) unique.push_back(e);
   if (unique.size() % 2 == 0) return std::nullopt;
   return unique.front();
+}
+
+void TriangleBuckets::build(const std::vector<std::array<Vec3, 2>>& boxes, double cell_size) {
+  Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  Vec3 hi{-lo[0], -lo[1], -lo[2]};
+  for (const auto& b : boxes)
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], b[0][d]);
+      hi[d] = std::max(hi[d], b[1][d]);
+    }
+  if (boxes.empty()) lo = hi = {0, 0, 0};
+  origin_ = lo;
+  inv_cell_ = 1.0 / cell_size;
+  for (int d = 0; d < 3; ++d) count_[d] = std::max(1, static_cast<int>(std::floor((hi[d] - lo[d]) * inv_cell_)) + 1);
+  const std::size_t cells = static_cast<std::size_t>(count_[0]) * static_cast<std::size_t>(count_[1]) * static_cast<std::size_t>(count_[2]);
+  start_.assign(cells + 1, 0);
+  auto range = [&](const std::array<Vec3, 2>& b, std::array<int, 3>& l, std::array<int, 3>& u) {
+    for (int d = 0; d < 3; ++d) {
+      l[d] = std::clamp(static_cast<int>(std::floor((b[0][d] - origin_[d]) * inv_cell_)), 0, count_[d] - 1);
+      u[d] = std::clamp(static_cast<int>(std::floor((b[1][d] - origin_[d]) * inv_cell_)), 0, count_[d] - 1);
+    }
+  };
+  auto cell = [&](int i, int j, int k) {
+    return (static_cast<std::size_t>(k) * static_cast<std::size_t>(count_[1]) + static_cast<std::size_t>(j)) *
+               static_cast<std::size_t>(count_[0]) + static_cast<std::size_t>(i);
+  };
+  std::array<int, 3> l{}, u{};
+  for (const auto& b : boxes) {  // counting pass, then fill (CSR)
+    range(b, l, u);
+    for (int k = l[2]; k <= u[2]; ++k)
+      for (int j = l[1]; j <= u[1]; ++j)
+        for (int i = l[0]; i <= u[0]; ++i) ++start_[cell(i, j, k) + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
+  items_.assign(start_[cells], 0);
+  std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+  for (std::size_t t = 0; t < boxes.size(); ++t) {
+    range(boxes[t], l, u);
+    for (int k = l[2]; k <= u[2]; ++k)
+      for (int j = l[1]; j <= u[1]; ++j)
+        for (int i = l[0]; i <= u[0]; ++i) items_[fill[cell(i, j, k)]++] = static_cast<std::uint32_t>(t);
+  }
+}
+
+void TriangleBuckets::query(const Vec3& lower, const Vec3& upper, std::vector<std::uint32_t>& out) const {
+  out.clear();
+  if (start_.empty()) return;
+  std::array<int, 3> l{}, u{};
+  for (int d = 0; d < 3; ++d) {
+    const double a = std::floor((lower[d] - origin_[d]) * inv_cell_), b = std::floor((upper[d] - origin_[d]) * inv_cell_);
+    if (b < 0 || a > count_[d] - 1) return;  // outside the grid: no triangle there
+    l[d] = static_cast<int>(std::max(a, 0.0));
+    u[d] = static_cast<int>(std::min(b, static_cast<double>(count_[d] - 1)));
+  }
+  for (int k = l[2]; k <= u[2]; ++k)
+    for (int j = l[1]; j <= u[1]; ++j)
+      for (int i = l[0]; i <= u[0]; ++i) {
+        const std::size_t c = (static_cast<std::size_t>(k) * static_cast<std::size_t>(count_[1]) + static_cast<std::size_t>(j)) *
+                                  static_cast<std::size_t>(count_[0]) + static_cast<std::size_t>(i);
+        out.insert(out.end(), items_.begin() + start_[c], items_.begin() + start_[c + 1]);
+      }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+std::vector<std::array<Vec3, 2>> triangle_boxes(const TriangleMesh& mesh, const std::vector<Vec3>* other) {
+  std::vector<std::array<Vec3, 2>> boxes(mesh.triangles.size());
+  for (std::size_t t = 0; t < boxes.size(); ++t) {
+    auto& b = boxes[t];
+    b[0] = b[1] = mesh.position[mesh.triangles[t][0]];
+    for (const auto* nodes : {&mesh.position, other}) {
+      if (nodes == nullptr) continue;
+      for (const std::uint32_t n : mesh.triangles[t])
+        for (int d = 0; d < 3; ++d) {
+          b[0][d] = std::min(b[0][d], (*nodes)[n][d]);
+          b[1][d] = std::max(b[1][d], (*nodes)[n][d]);
+        }
+    }
+  }
+  return boxes;
+}
+
+void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& candidates, const Vec3& x, double radius,
+                      std::vector<std::uint32_t>& out) {
+  out.clear();
+  thread_local std::vector<std::pair<double, std::uint32_t>> found;
+  found.clear();
+  for (const std::uint32_t t : candidates) {
+    const TrianglePoint tp = closest_on_triangle(x, corner(mesh, t, 0), corner(mesh, t, 1), corner(mesh, t, 2));
+    Vec3 point{0, 0, 0};
+    for (int k = 0; k < 3; ++k) point = add(point, scale(corner(mesh, t, k), tp.barycentric[static_cast<std::size_t>(k)]));
+    const Vec3 r = sub(x, point);
+    const double d2 = dot(r, r);
+    if (d2 < radius * radius) found.push_back({d2, t});
+  }
+  std::sort(found.begin(), found.end());
+  for (const auto& [d2, t] : found) out.push_back(t);
 }
 
 }  // namespace valvefsi::fluid::thin_wall

@@ -13,6 +13,7 @@
 #include "valvefsi/fluid/fluid_settings.hpp"
 #include "valvefsi/fluid/immersed_surface.hpp"
 #include "valvefsi/fluid/thin_wall/two_sided_wall.hpp"
+#include "valvefsi/fluid/thin_wall/window_motion.hpp"
 
 namespace valvefsi::fluid::thin_wall {
 
@@ -23,35 +24,7 @@ namespace valvefsi::fluid::thin_wall {
 // two segments (a branch), a repeated segment or a closed loop.
 std::vector<std::vector<std::uint32_t>> chains_from_segments(std::size_t node_count, std::span<const std::uint32_t> cells);
 
-// The nodes' motion through one coupling window [start_time, end_time]: the cubic Hermite
-// curve through the start state (positions, velocities) and the coupler's end state. Exact for
-// any motion that is cubic in time; gives the accelerations the wall condition needs. After
-// end_time the nodes go on at their end velocity (no new target yet).
-class WindowMotion {
- public:
-  // Nodes at rest at `positions` at `time`.
-  WindowMotion(std::vector<Vec2> positions, double time);
-
-  // The window starts at the last evaluated time (the construction time at first) from the
-  // state there. Throws std::invalid_argument unless end_time > that time and the spans
-  // have one entry per node.
-  void set_target(double end_time, std::span<const Vec2> end_positions, std::span<const Vec2> end_velocities);
-  // Position, velocity and acceleration of every node at `time`; the time becomes current.
-  void evaluate(double time, std::vector<Vec2>& positions, std::vector<Vec2>& velocities,
-                std::vector<Vec2>& accelerations);
-
-  double current_time() const { return current_time_; }
-  double start_time() const { return start_time_; }
-  double end_time() const { return end_time_; }
-  // Largest node speed at the start and the end of the window.
-  double max_end_speed() const;
-
- private:
-  double start_time_, end_time_, current_time_;
-  std::vector<Vec2> x0_, v0_, x1_, v1_;
-  // The state at the current time (a new window starts from it).
-  std::vector<Vec2> x_, v_;
-};
+using WindowMotion = WindowMotionT<2>;
 
 // ImmersedSurfaceModel<2> over one TwoSidedWall per chain. Node indices in the interface are
 // those of the coupler's geometry.

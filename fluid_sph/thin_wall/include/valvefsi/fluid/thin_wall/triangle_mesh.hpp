@@ -32,6 +32,16 @@ struct TriangleMesh {
   // Per triangle, edge e joins corners e and (e + 1) % 3.
   std::vector<std::array<Vec3, 3>> edge_normal;
   std::vector<std::array<bool, 3>> edge_on_boundary;
+
+ private:
+  // Connectivity cache (built at the first update, or when the triangle count changes): for
+  // every edge, the triangles and their local edge numbers that share it.
+  struct Edge {
+    std::uint32_t first = 0, second = 0;
+    std::vector<std::pair<std::uint32_t, int>> users;
+  };
+  std::vector<Edge> edges_;
+  std::size_t edges_for_ = static_cast<std::size_t>(-1);
 };
 
 struct ClosestPoint3 {
@@ -53,8 +63,12 @@ ClosestPoint3 closest_point(const TriangleMesh& mesh, const std::vector<std::uin
 struct Crossing3 {
   std::size_t triangle = 0;
   double s = 0.0;
+  Vec3 barycentric{};  // of the meeting point in its triangle
 };
 std::optional<Crossing3> first_crossing(const TriangleMesh& mesh, const Vec3& p, const Vec3& q);
+// The same over a subset of triangles (candidates from a spatial search).
+std::optional<Crossing3> first_crossing(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles, const Vec3& p,
+                                        const Vec3& q);
 
 // Continuous test over a step: the point moves x0 -> x1 and the nodes before -> after, all
 // linearly in tau in [0, 1]. A root of the coplanarity cubic counts when the point is inside
@@ -66,5 +80,31 @@ struct SweptCrossing3 {
 };
 std::optional<SweptCrossing3> swept_crossing(const TriangleMesh& mesh, const std::vector<Vec3>& before,
                                              const std::vector<Vec3>& after, const Vec3& x0, const Vec3& x1);
+std::optional<SweptCrossing3> swept_crossing(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles,
+                                             const std::vector<Vec3>& before, const std::vector<Vec3>& after, const Vec3& x0,
+                                             const Vec3& x1);
+
+// Uniform bucket grid over the triangles' bounding boxes: the candidates of a query box are
+// the triangles registered in the cells it overlaps (a superset of those that meet it).
+class TriangleBuckets {
+ public:
+  // One box (lower, upper) per triangle; cell_size > 0.
+  void build(const std::vector<std::array<Vec3, 2>>& boxes, double cell_size);
+  // Triangles whose box may overlap [lower, upper], each once, ascending.
+  void query(const Vec3& lower, const Vec3& upper, std::vector<std::uint32_t>& out) const;
+
+ private:
+  Vec3 origin_{};
+  double inv_cell_ = 1.0;
+  std::array<int, 3> count_{};
+  std::vector<std::uint32_t> start_, items_;
+};
+
+// Bounding boxes of every triangle over one or two node sets (before and after a move).
+std::vector<std::array<Vec3, 2>> triangle_boxes(const TriangleMesh& mesh, const std::vector<Vec3>* other = nullptr);
+// Triangles within `radius` of x among the candidates (exact point-triangle distance), the
+// nearest first (queries that stop at the first hit then test the likely one first).
+void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& candidates, const Vec3& x, double radius,
+                      std::vector<std::uint32_t>& out);
 
 }  // namespace valvefsi::fluid::thin_wall

@@ -1,0 +1,186 @@
+// Experiment program for the 3D thin-wall scenes on FluidSolver<3> with ThinWallModel3D: runs
+// one scene and writes its time series (force on the surface, counters, cost per step) as CSV
+// for docs/thin-leaflet.md; --no-surface runs the same particles without the surface (cost
+// reference).
+#include <CLI/CLI.hpp>
+#include <omp.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+#include "valvefsi/case/case_loader.hpp"
+#include "valvefsi/fluid/case_setup.hpp"
+#include "valvefsi/fluid/thin_wall/scenes_3d.hpp"
+#include "valvefsi/fluid/thin_wall/solver_run_3d.hpp"
+
+using namespace valvefsi::fluid;
+using namespace valvefsi::fluid::thin_wall;
+
+namespace {
+
+// A surface as plain text (scripts/dump_surface.py): "N", N lines "x y z t", "M", M lines "a b c".
+ImmersedSurfaceGeometry<3> read_surface(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error("cannot open " + file);
+  ImmersedSurfaceGeometry<3> g;
+  g.nodes_per_cell = 3;
+  std::size_t n = 0, m = 0;
+  in >> n;
+  g.nodes.resize(n);
+  g.node_thickness.resize(n);
+  for (std::size_t k = 0; k < n; ++k) in >> g.nodes[k][0] >> g.nodes[k][1] >> g.nodes[k][2] >> g.node_thickness[k];
+  in >> m;
+  g.cells.resize(3 * m);
+  for (auto& c : g.cells) in >> c;
+  if (!in) throw std::runtime_error("bad surface file " + file);
+  return g;
+}
+
+// The fluid part of a case (e.g. the coupled sector) at rest with the solid's surface at
+// rest in it, for a number of steps: loads at rest, leaks and the cost per step, with and
+// without the surface.
+int run_case_at_rest(const std::string& case_file, const std::string& surface_file, long steps, bool no_surface, bool aligned, bool behind_only) {
+  const valvefsi::cases::Case c = valvefsi::load_case(case_file);
+  auto setup = fluid_setup_from_case<3>(c, case_file);
+  FluidSolver<3> solver = make_solver<3>(std::move(setup));
+  const ThinWallModel3D* model = nullptr;
+  if (!no_surface) {
+    ThinWall3DSettings settings;
+    settings.wall_acceleration_in_pressure = c.fluid().thin_walls().wall_acceleration_in_pressure();
+    settings.particle_aligned_layers = aligned;
+    settings.lattice_in_front = !behind_only;
+    auto m = std::make_unique<ThinWallModel3D>(read_surface(surface_file), solver.settings(), settings);
+    model = m.get();
+    solver.set_immersed_surface(std::move(m));
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  for (long k = 0; k < steps; ++k) solver.step();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("%s: %zu particles, %ld steps to t = %.3g s, %.2f s, %.2f ms/step\n", no_surface ? "no surface" : "with surface",
+              solver.particles().size(), steps, solver.time(), wall, 1e3 * wall / static_cast<double>(steps));
+  if (model) {
+    const auto k = model->counters();
+    const Vec3 f = model->total_force();
+    double largest = 0;
+    std::vector<Vec<3>> forces(model->node_count());
+    model->node_forces(forces);
+    double largest_pressure = 0, mean_pressure = 0, area = 0;
+    for (std::size_t j = 0; j < forces.size(); ++j) {
+      const auto& x = forces[j];
+      const double f = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+      largest = std::max(largest, f);
+      largest_pressure = std::max(largest_pressure, f / model->node_areas()[j]);
+      mean_pressure += f;
+      area += model->node_areas()[j];
+    }
+    std::printf("node loads over node areas: largest %.4g Pa, mean %.4g Pa (leaflet area %.4g m^2)\n", largest_pressure,
+                mean_pressure / area, area);
+    if (const char* dump = std::getenv("THIN_WALL_NODE_DUMP")) {
+      std::ofstream out(dump);
+      out << "x,y,z,fx,fy,fz,area,p0,p1,w0,w1\n";
+      const auto& m = model->mesh();
+      for (std::size_t j = 0; j < forces.size(); ++j) {
+        const auto& st = model->node_states()[j];
+        out << m.position[j][0] << ',' << m.position[j][1] << ',' << m.position[j][2] << ',' << forces[j][0] << ','
+            << forces[j][1] << ',' << forces[j][2] << ',' << model->node_areas()[j] << ',' << st.side[0].pressure << ','
+            << st.side[1].pressure << ',' << st.side[0].weight << ',' << st.side[1].weight << '\n';
+      }
+    }
+    std::printf("surface: %zu particles near it; total force %.4g %.4g %.4g N, largest node force %.3g N; corrections %zu leaks %zu "
+                "rejected shifts %zu; lost %zu\n",
+                model->near_count(), f[0], f[1], f[2], largest, k.corrections, k.leaks, k.rejected_shifts, solver.lost_count());
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"3D thin-wall scenes: two_levels, gap, disk, flap"};
+  std::string scene = "two_levels", output;
+  double dp = 0.025, end_time = 0.5, gap = 0.1, width = 0.15, sample_interval = 1e-3, lattice_ratio = 1.0, window = 1e-3;
+  bool mirror = false, no_surface = false;
+  OscillatingDisk disk;
+  RockingFlap flap;
+  app.add_option("--scene", scene, "two_levels | gap | disk | flap")->check(CLI::IsMember({"two_levels", "gap", "disk", "flap"}));
+  app.add_option("--dp", dp, "particle spacing (m)");
+  app.add_option("--end", end_time, "end time (s)");
+  app.add_option("--gap", gap, "gap under the membrane (m), scene gap");
+  app.add_option("--width", width, "tank width (m), scenes two_levels and gap");
+  app.add_flag("--mirror", mirror, "two_levels/gap: mirror planes instead of side walls");
+  app.add_option("--lattice-ratio", lattice_ratio, "virtual lattice spacing / dp");
+  app.add_option("--window", window, "motion window (s)");
+  app.add_option("--radius", disk.radius, "disk radius a (m)");
+  app.add_option("--amplitude", disk.amplitude, "disk amplitude A (m)");
+  app.add_option("--period", disk.period, "disk period (s)");
+  app.add_option("--box", disk.box, "disk box side (m)");
+  app.add_flag("--no-surface", no_surface, "run the same particles without the surface (cost reference)");
+  app.add_option("--sample", sample_interval, "output interval (s)");
+  app.add_option("--output", output, "CSV file of the time series");
+  std::string case_file, surface_file;
+  long steps = 100;
+  app.add_option("--case", case_file, "a 3D case file: run its fluid at rest with --surface in it (no scene)");
+  app.add_option("--surface", surface_file, "surface as text (scripts/dump_surface.py), with --case");
+  app.add_option("--steps", steps, "steps, with --case");
+  bool aligned = false, behind_only = false;
+  app.add_flag("--behind-only", behind_only, "virtual lattice behind the tangent plane only");
+  app.add_flag("--aligned-layers", aligned, "virtual layers continue the particle's own lattice through the wall");
+  CLI11_PARSE(app, argc, argv);
+  if (!case_file.empty()) return run_case_at_rest(case_file, surface_file, steps, no_surface, aligned, behind_only);
+
+  ThinWallCase3D c = scene == "two_levels" ? two_level_tank_3d(dp, 0.5, 0.25, width, 0.0, mirror)
+                     : scene == "gap"      ? two_level_tank_3d(dp, 0.5, 0.25, width, gap, mirror)
+                     : scene == "disk"     ? oscillating_disk_box(dp, disk)
+                                           : rocking_flap_box(dp, flap);
+  c.wall_settings.virtual_spacing_ratio = lattice_ratio;
+  c.wall_settings.particle_aligned_layers = aligned;
+  c.wall_settings.lattice_in_front = !behind_only;
+  std::ofstream csv;
+  if (!output.empty()) {
+    csv.open(output);
+    csv << "time,fx,fy,fz,X,V,corrections,leaks,rejected_shifts,lost,near,steps,wall_s\n";
+  }
+  if (no_surface) {
+    FluidSolver<3> solver(c.fluid, fill_particles<3>(c.scene, c.fluid));
+    const auto t0 = std::chrono::steady_clock::now();
+    solver.advance_to(end_time);
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("no surface: %zu particles, %ld steps, %.2f s, %.3f ms/step\n", solver.particles().size(), solver.step_count(), wall,
+                1e3 * wall / static_cast<double>(solver.step_count()));
+    return 0;
+  }
+  ThinWallSolverRun3D flow(std::move(c), window);
+  const double omega = 2.0 * std::numbers::pi / disk.period;
+  const auto t0 = std::chrono::steady_clock::now();
+  double next = 0.0;
+  while (flow.time() < end_time * (1.0 - 1e-12)) {
+    flow.step();
+    if (flow.time() >= next - 1e-12) {
+      next += sample_interval;
+      const Vec3 f = flow.wall_force();
+      const auto k = flow.model().counters();
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double t = flow.time();
+      if (csv)
+        csv << t << ',' << f[0] << ',' << f[1] << ',' << f[2] << ',' << -disk.amplitude * std::cos(omega * t) << ','
+            << disk.amplitude * omega * std::sin(omega * t) << ',' << k.corrections << ',' << k.leaks << ',' << k.rejected_shifts
+            << ',' << flow.solver().lost_count() << ',' << flow.model().near_count() << ',' << flow.step_count() << ',' << wall
+            << '\n';
+    }
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const auto k = flow.model().counters();
+  const Vec3 f = flow.wall_force();
+  std::printf("%s: %zu particles (%zu near the surface), %ld steps, %.2f s, %.3f ms/step; force %.4g %.4g %.4g N; "
+              "corrections %zu leaks %zu rejected shifts %zu lost %zu\n",
+              scene.c_str(), flow.particles().size(), flow.model().near_count(), flow.step_count(), wall,
+              1e3 * wall / static_cast<double>(flow.step_count()), f[0], f[1], f[2], k.corrections, k.leaks, k.rejected_shifts,
+              flow.solver().lost_count());
+  return 0;
+}

@@ -1,0 +1,668 @@
+#include "valvefsi/fluid/thin_wall/thin_wall_model_3d.hpp"
+
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "valvefsi/case/case_loader.hpp"
+#include "valvefsi/fluid/equation_of_state.hpp"
+#include "valvefsi/fluid/kernels.hpp"
+
+namespace valvefsi::fluid::thin_wall {
+namespace {
+
+constexpr const char* kSource = "interface surface from the coupler";
+
+Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
+
+Vec3 position_of(const Particles<3>& p, std::size_t i) { return {p.position[0][i], p.position[1][i], p.position[2][i]}; }
+
+int side_index(int side) { return side > 0 ? 1 : 0; }
+
+// Cell of a point in the grid's numbering (x fastest), clamped into the grid.
+std::size_t cell_of_point(const CellGrid<3>& grid, const Vec3& x) {
+  std::size_t c = 0;
+  for (int d = 2; d >= 0; --d) {
+    int k = static_cast<int>(std::floor((x[d] - grid.lower()[d]) / grid.cell_size(d)));
+    k = std::clamp(k, 0, grid.cells_along(d) - 1);
+    c = c * static_cast<std::size_t>(grid.cells_along(d)) + static_cast<std::size_t>(k);
+  }
+  return c;
+}
+
+// Cheap rejections before the exact test: both ends strictly on one side of the triangle's
+// plane, or the point where the segment meets that plane outside the triangle's box.
+bool may_meet(const std::array<Vec3, 2>& box, double sp, double sq, const Vec3& p, const Vec3& q) {
+  if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0)) return false;
+  const double denominator = sp - sq;
+  if (denominator == 0.0) return true;  // in the plane: let the exact test decide
+  const double f = sp / denominator;
+  const double pad = 1e-9 * (std::abs(box[1][0] - box[0][0]) + std::abs(box[1][1] - box[0][1]) + std::abs(box[1][2] - box[0][2]));
+  for (int d = 0; d < 3; ++d) {
+    const double x = p[d] + f * (q[d] - p[d]);
+    if (x < box[0][d] - pad || x > box[1][d] + pad) return false;
+  }
+  return true;
+}
+
+// Whether the segment p -> q meets any of the triangles (touching counts).
+bool crosses_any(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles, const std::vector<Vec3>& normal,
+                 const std::vector<double>& offset, const std::vector<std::array<Vec3, 2>>& boxes, const Vec3& p,
+                 const Vec3& q) {
+  thread_local std::vector<std::uint32_t> one(1);
+  for (const std::uint32_t t : triangles) {
+    const double sp = dot(normal[t], p) - offset[t], sq = dot(normal[t], q) - offset[t];
+    if (!may_meet(boxes[t], sp, sq, p, q)) continue;
+    one[0] = t;
+    if (first_crossing(mesh, one, p, q)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::size_t orient_consistently(std::vector<std::array<std::uint32_t, 3>>& triangles) {
+  // Edge -> (triangle, direction +1 if it runs low -> high node).
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::pair<std::size_t, int>>> edges;
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t i = triangles[t][static_cast<std::size_t>(k)], j = triangles[t][static_cast<std::size_t>((k + 1) % 3)];
+      auto& users = edges[{std::min(i, j), std::max(i, j)}];
+      users.push_back({t, i < j ? 1 : -1});
+      if (users.size() > 2)
+        throw std::invalid_argument(fmt::format("{}: the edge between nodes {} and {} is shared by more than two triangles ({}, {}, "
+                                                "{}): a leaflet is a surface with no branches",
+                                                kSource, std::min(i, j), std::max(i, j), users[0].first, users[1].first, t));
+    }
+  std::vector<std::vector<std::pair<std::size_t, bool>>> neighbours(triangles.size());  // (other, same direction)
+  for (const auto& [key, users] : edges)
+    if (users.size() == 2) {
+      const bool same = users[0].second == users[1].second;
+      neighbours[users[0].first].push_back({users[1].first, same});
+      neighbours[users[1].first].push_back({users[0].first, same});
+    }
+  std::vector<int> flip(triangles.size(), -1);  // -1 unvisited, 0 keep, 1 flip
+  std::size_t flipped = 0;
+  for (std::size_t seed = 0; seed < triangles.size(); ++seed) {
+    if (flip[seed] >= 0) continue;
+    flip[seed] = 0;
+    std::vector<std::size_t> stack{seed};
+    while (!stack.empty()) {
+      const std::size_t t = stack.back();
+      stack.pop_back();
+      for (const auto& [o, same] : neighbours[t]) {
+        // Consistent neighbours traverse the shared edge in opposite directions.
+        const int want = same ? 1 - flip[t] : flip[t];
+        if (flip[o] < 0) {
+          flip[o] = want;
+          stack.push_back(o);
+        } else if (flip[o] != want) {
+          throw std::invalid_argument(fmt::format("{}: triangles {} and {} cannot be oriented consistently (a non-orientable "
+                                                  "surface): the two sides of a leaflet must be distinct",
+                                                  kSource, t, o));
+        }
+      }
+    }
+  }
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    if (flip[t] == 1) {
+      std::swap(triangles[t][1], triangles[t][2]);
+      ++flipped;
+    }
+  return flipped;
+}
+
+ThinWallModel3D::ThinWallModel3D(const ImmersedSurfaceGeometry<3>& g, const FluidSettings<3>& fluid, ThinWall3DSettings settings)
+    : fluid_(fluid), settings_(settings), node_count_(g.nodes.size()), planes_(fluid.mirror_planes),
+      dyn_(WindowMotionT<3>(std::vector<Vec3>(g.nodes.begin(), g.nodes.end()), 0.0)) {
+  if (g.nodes_per_cell != 3)
+    throw std::invalid_argument(fmt::format("{}: nodes_per_cell = {}: allowed 3 (triangles) in 3D", kSource, g.nodes_per_cell));
+  if (g.cells.empty() || g.cells.size() % 3 != 0)
+    throw std::invalid_argument(fmt::format("{}: cells has {} entries: allowed 3 per triangle, at least one triangle", kSource,
+                                            g.cells.size()));
+  if (g.node_thickness.size() != node_count_)
+    throw std::invalid_argument(fmt::format("{}: node_thickness has {} entries: allowed one per node ({})", kSource,
+                                            g.node_thickness.size(), node_count_));
+  const double dp = fluid.particle_spacing;
+  double thickest = 0.0;
+  for (std::size_t k = 0; k < node_count_; ++k) {
+    if (!(g.node_thickness[k] >= 0.0) || !(g.node_thickness[k] < dp))
+      throw std::invalid_argument(fmt::format("{}: node_thickness[{}] = {} m: allowed 0 <= t < the particle spacing {} m", kSource,
+                                              k, g.node_thickness[k], dp));
+    thickest = std::max(thickest, g.node_thickness[k]);
+  }
+  if (!(settings_.virtual_spacing_ratio > 0))
+    throw std::invalid_argument(fmt::format("thin wall 3D: virtual_spacing_ratio = {}: allowed > 0", settings_.virtual_spacing_ratio));
+  std::vector<std::array<std::uint32_t, 3>> triangles(g.cells.size() / 3);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t n = g.cells[3 * t + static_cast<std::size_t>(k)];
+      if (n >= node_count_)
+        throw std::invalid_argument(fmt::format("{}: triangle {} names node {}: allowed 0 to {}", kSource, t, n, node_count_ - 1));
+      triangles[t][static_cast<std::size_t>(k)] = n;
+    }
+    const auto& tri = triangles[t];
+    const Vec3 n = cross(sub(g.nodes[tri[1]], g.nodes[tri[0]]), sub(g.nodes[tri[2]], g.nodes[tri[0]]));
+    if (!(norm(n) > 1e-12 * dp * dp))
+      throw std::invalid_argument(
+          fmt::format("{}: triangle {} (nodes {}, {}, {}) has no area: allowed non-degenerate triangles", kSource, t, tri[0], tri[1], tri[2]));
+  }
+  orient_consistently(triangles);
+  real_triangles_ = triangles.size();
+  area_.assign(node_count_, 0.0);
+  for (const auto& tri : triangles) {
+    const double a = 0.5 * norm(cross(sub(g.nodes[tri[1]], g.nodes[tri[0]]), sub(g.nodes[tri[2]], g.nodes[tri[0]])));
+    for (const std::uint32_t n : tri) area_[n] += a / 3.0;
+  }
+  clearance_ = std::max(settings_.clearance_ratio * dp, 0.5 * thickest);
+
+  // The mesh with its mirror images: a node on a plane is its own image, so the leaflet and
+  // its image share the edge along the symmetry line (an interior edge, not a free one).
+  mesh_.triangles = triangles;
+  origin_node_.resize(node_count_);
+  for (std::uint32_t k = 0; k < node_count_; ++k) origin_node_[k] = k;
+  node_plane_.assign(node_count_, -1);
+  triangle_plane_.assign(real_triangles_, -1);
+  for (std::size_t p = 0; p < planes_.size(); ++p) {
+    std::vector<std::uint32_t> image(node_count_);
+    for (std::uint32_t k = 0; k < node_count_; ++k) {
+      double distance = 0;
+      for (int d = 0; d < 3; ++d) distance += (g.nodes[k][d] - planes_[p].point[d]) * planes_[p].normal[d];
+      if (std::abs(distance) < 1e-3 * dp) {
+        image[k] = k;
+      } else {
+        image[k] = static_cast<std::uint32_t>(origin_node_.size());
+        origin_node_.push_back(k);
+        node_plane_.push_back(static_cast<int>(p));
+      }
+    }
+    for (std::size_t t = 0; t < real_triangles_; ++t) {
+      const auto& tri = triangles[t];
+      if (image[tri[0]] == tri[0] && image[tri[1]] == tri[1] && image[tri[2]] == tri[2]) continue;  // in the plane
+      // A reflection turns the orientation over: swap two corners to keep the sides.
+      mesh_.triangles.push_back({image[tri[0]], image[tri[2]], image[tri[1]]});
+      triangle_plane_.push_back(static_cast<int>(p));
+    }
+  }
+  mesh_.position.resize(origin_node_.size());
+  move_to(0.0);
+}
+
+Vec3 ThinWallModel3D::reflect_vector(int plane, const Vec3& v) const {
+  if (plane < 0) return v;
+  const auto& n = planes_[static_cast<std::size_t>(plane)].normal;
+  const double s = 2.0 * (v[0] * n[0] + v[1] * n[1] + v[2] * n[2]);
+  return {v[0] - s * n[0], v[1] - s * n[1], v[2] - s * n[2]};
+}
+
+void ThinWallModel3D::place_mesh() {
+  const std::size_t n = origin_node_.size();
+  mesh_velocity_.resize(n);
+  mesh_acceleration_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t j = origin_node_[k];
+    const int plane = node_plane_[k];
+    Vec3 x = dyn_.x[j];
+    if (plane >= 0) {
+      const auto& pl = planes_[static_cast<std::size_t>(plane)];
+      double distance = 0;
+      for (int d = 0; d < 3; ++d) distance += (x[d] - pl.point[d]) * pl.normal[d];
+      for (int d = 0; d < 3; ++d) x[d] -= 2.0 * distance * pl.normal[d];
+    }
+    mesh_.position[k] = x;
+    mesh_velocity_[k] = reflect_vector(plane, dyn_.v[j]);
+    mesh_acceleration_[k] = reflect_vector(plane, dyn_.a[j]);
+  }
+  mesh_.update();
+  face_normal_.resize(mesh_.triangles.size());
+  face_offset_.resize(mesh_.triangles.size());
+  face_box_ = triangle_boxes(mesh_);
+  for (std::size_t t = 0; t < mesh_.triangles.size(); ++t) {
+    face_normal_[t] = mesh_.face_normal(t);
+    face_offset_[t] = dot(face_normal_[t], mesh_.position[mesh_.triangles[t][0]]);
+  }
+}
+
+void ThinWallModel3D::set_window_target(double end_time, std::span<const Vec<3>> end_positions,
+                                        std::span<const Vec<3>> end_velocities) {
+  dyn_.motion.set_target(end_time, end_positions, end_velocities);
+}
+
+void ThinWallModel3D::move_to(double time) {
+  dyn_.motion.evaluate(time, dyn_.x, dyn_.v, dyn_.a);
+  place_mesh();
+}
+
+double ThinWallModel3D::max_node_speed() const {
+  double v2 = 0.0;
+  for (const auto& v : dyn_.v) v2 = std::max(v2, dot(v, v));
+  return std::max(std::sqrt(v2), dyn_.motion.max_end_speed());
+}
+
+void ThinWallModel3D::begin_step(const Particles<3>& p) {
+  auto& s = dyn_;
+  s.start_position.resize(p.size());
+  std::uint32_t max_id = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    s.start_position[i] = position_of(p, i);
+    max_id = std::max(max_id, p.id[i]);
+  }
+  s.start_nodes = mesh_.position;
+  s.previous_by_id.resize(static_cast<std::size_t>(max_id) + 1);
+  for (std::size_t i = 0; i < p.size(); ++i) s.previous_by_id[p.id[i]] = s.start_position[i];
+  std::fill(s.corrected_by_id.begin(), s.corrected_by_id.end(), std::uint8_t{0});
+}
+
+void ThinWallModel3D::correct_crossings(Particles<3>& p) {
+  auto& s = dyn_;
+  if (s.start_nodes.size() != mesh_.position.size() || s.start_position.size() != p.size()) return;  // no begin_step yet
+  const double R = fluid_.support_radius();
+  TriangleBuckets swept;
+  swept.build(triangle_boxes(mesh_, &s.start_nodes), R);
+  Vec3 lo = mesh_.position[0], hi = mesh_.position[0];
+  for (const auto* nodes : {&s.start_nodes, &mesh_.position})
+    for (const auto& x : *nodes)
+      for (int d = 0; d < 3; ++d) {
+        lo[d] = std::min(lo[d], x[d]);
+        hi[d] = std::max(hi[d], x[d]);
+      }
+  std::size_t corrections = 0;
+  const auto count = static_cast<std::ptrdiff_t>(p.size());
+#pragma omp parallel reduction(+ : corrections)
+  {
+    std::vector<std::uint32_t> candidates, one(1);
+#pragma omp for schedule(dynamic, 256)
+    for (std::ptrdiff_t ii = 0; ii < count; ++ii) {
+      const auto i = static_cast<std::size_t>(ii);
+      if (p.kind[i] != Kind::fluid) continue;
+      const Vec3 x0 = s.start_position[i];
+      const Vec3 x1 = position_of(p, i);
+      bool outside = false;
+      for (int d = 0; d < 3; ++d) outside = outside || std::min(x0[d], x1[d]) > hi[d] || std::max(x0[d], x1[d]) < lo[d];
+      if (outside) continue;
+      swept.query({std::min(x0[0], x1[0]), std::min(x0[1], x1[1]), std::min(x0[2], x1[2])},
+                  {std::max(x0[0], x1[0]), std::max(x0[1], x1[1]), std::max(x0[2], x1[2])}, candidates);
+      if (candidates.empty()) continue;
+      const auto hit = swept_crossing(mesh_, candidates, s.start_nodes, mesh_.position, x0, x1);
+      if (!hit) continue;
+      const std::size_t t = hit->triangle;
+      const auto& tri = mesh_.triangles[t];
+      // Side at the start of the step, from the triangle that was crossed.
+      const Vec3 n0 = cross(sub(s.start_nodes[tri[1]], s.start_nodes[tri[0]]), sub(s.start_nodes[tri[2]], s.start_nodes[tri[0]]));
+      const double side = dot(sub(x0, s.start_nodes[tri[0]]), n0) >= 0.0 ? 1.0 : -1.0;
+      const Vec3 n{side * face_normal_[t][0], side * face_normal_[t][1], side * face_normal_[t][2]};
+      const double signed_distance = dot(sub(x1, mesh_.position[tri[0]]), n);
+      const double depth = std::max(-signed_distance, 0.0);
+      const double move = depth + std::max(depth, clearance_);
+      for (int d = 0; d < 3; ++d) p.position[d][i] = x1[d] + move * n[d];
+      // Reflect the velocity relative to the wall, normal part only, if it points into the wall.
+      one[0] = static_cast<std::uint32_t>(t);
+      const ClosestPoint3 c = closest_point(mesh_, one, x1);
+      Vec3 vw{0, 0, 0};
+      for (int k = 0; k < 3; ++k)
+        for (int d = 0; d < 3; ++d) vw[d] += c.barycentric[static_cast<std::size_t>(k)] * mesh_velocity_[tri[static_cast<std::size_t>(k)]][d];
+      double vn = 0;
+      for (int d = 0; d < 3; ++d) vn += (p.velocity[d][i] - vw[d]) * n[d];
+      if (vn < 0.0)
+        for (int d = 0; d < 3; ++d) {
+          p.velocity[d][i] = static_cast<float>(p.velocity[d][i] - 2.0 * vn * n[d]);
+          p.viscous_velocity[d][i] = p.velocity[d][i];
+        }
+      if (p.id[i] < s.corrected_by_id.size()) s.corrected_by_id[p.id[i]] = 1;
+      ++corrections;
+    }
+  }
+  s.counters.corrections += corrections;
+}
+
+void ThinWallModel3D::classify(const Particles<3>& p) {
+  auto& s = dyn_;
+  const std::size_t n = p.size();
+  s.near.assign(n, NearWall{});
+  s.candidates.resize(n);
+  std::uint32_t max_id = 0;
+  for (std::size_t i = 0; i < n; ++i) max_id = std::max(max_id, p.id[i]);
+  if (s.side_by_id.size() <= max_id) s.side_by_id.resize(max_id + 1, 0);
+  if (s.corrected_by_id.size() <= max_id) s.corrected_by_id.resize(max_id + 1, 0);
+  const double R = fluid_.support_radius();
+  buckets_.build(face_box_, R);
+  Vec3 lo = mesh_.position[0], hi = mesh_.position[0];
+  for (const auto& x : mesh_.position)
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], x[d] - R);
+      hi[d] = std::max(hi[d], x[d] + R);
+    }
+  std::size_t leaks = 0;
+  const auto count = static_cast<std::ptrdiff_t>(n);
+#pragma omp parallel reduction(+ : leaks)
+  {
+    std::vector<std::uint32_t> boxed;
+#pragma omp for schedule(dynamic, 256)
+    for (std::ptrdiff_t ii = 0; ii < count; ++ii) {
+      const auto i = static_cast<std::size_t>(ii);
+      auto& cand = s.candidates[i];
+      cand.clear();
+      if (p.kind[i] == Kind::lost) continue;
+      const std::uint32_t id = p.id[i];
+      const Vec3 x = position_of(p, i);
+      bool outside = false;
+      for (int d = 0; d < 3; ++d) outside = outside || x[d] < lo[d] || x[d] > hi[d];
+      if (!outside) {
+        buckets_.query({x[0] - R, x[1] - R, x[2] - R}, {x[0] + R, x[1] + R, x[2] + R}, boxed);
+        triangles_within(mesh_, boxed, x, R, cand);
+      }
+      if (cand.empty()) {
+        if (p.kind[i] == Kind::fluid) s.side_by_id[id] = 0;
+        continue;
+      }
+      NearWall& nw = s.near[i];
+      nw.closest = closest_point(mesh_, cand, x);
+      nw.near = true;
+      if (p.kind[i] != Kind::fluid) continue;
+      // A particle may change side only round a free edge or through a put-back; otherwise
+      // it leaked (entering the near zone from outside cannot be a crossing). A straight step
+      // that misses the mesh went round the edge.
+      auto& remembered = s.side_by_id[id];
+      const auto side = static_cast<std::int8_t>(nw.closest.side);
+      if (remembered != 0 && remembered != side && !nw.closest.on_boundary && !s.corrected_by_id[id] &&
+          (id >= s.previous_by_id.size() || crosses_any(mesh_, cand, face_normal_, face_offset_, face_box_, s.previous_by_id[id], x)))
+        ++leaks;
+      remembered = side;
+    }
+  }
+  s.counters.leaks += leaks;
+}
+
+bool ThinWallModel3D::blocked(std::uint32_t a, std::uint32_t b, const Particles<3>& p) const {
+  const auto& near = dyn_.near;
+  if (!near[a].near || !near[b].near) return false;
+  const Vec3 xa = position_of(p, a), xb = position_of(p, b);
+  const double ab = norm(sub(xb, xa));
+  // Beyond the support the pair has no weight (the solver may ask before its distance cut);
+  // and the distance to the mesh changes by at most the distance moved, so a segment shorter
+  // than the sum of its ends' distances cannot reach the mesh.
+  const double R = fluid_.support_radius();
+  if (ab >= R || ab < near[a].closest.distance + near[b].closest.distance) return false;
+  return crosses_any(mesh_, dyn_.candidates[a], face_normal_, face_offset_, face_box_, xa, xb);
+}
+
+void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGrid<3>& grid) {
+  auto& s = dyn_;
+  const double R = fluid_.support_radius();
+  const double tiny = 1e-6 * fluid_.particle_spacing;
+  s.state.resize(node_count_);
+  const auto count = static_cast<std::ptrdiff_t>(node_count_);
+  with_kernel<3>(fluid_.kernel, fluid_.smoothing_length(), [&](const auto& W) {
+#pragma omp parallel for schedule(dynamic, 4)
+    for (std::ptrdiff_t jj = 0; jj < count; ++jj) {
+      const auto j = static_cast<std::size_t>(jj);
+      const Vec3 xm = mesh_.position[j];
+      Vec3 nm = mesh_.vertex_normal[j];
+      const double nl = norm(nm);
+      nm = {nm[0] / nl, nm[1] / nl, nm[2] / nl};
+      const Vec3 am = settings_.wall_acceleration_in_pressure ? dyn_.a[j] : Vec3{0, 0, 0};
+      std::array<NeighbourSegment<3>, 27> segments;
+      const int segment_count = grid.neighbour_segments(cell_of_point(grid, xm), segments);
+      double sw[2] = {0, 0}, sp[2] = {0, 0}, srr[2][3] = {}, sv[2][3] = {};
+      for (int g = 0; g < segment_count; ++g) {
+        const auto& seg = segments[static_cast<std::size_t>(g)];
+        for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
+          if (!acts_as_fluid(p.kind[b]) || !s.near[b].near) continue;
+          const Vec3 xb{p.position[0][b] + seg.shift[0], p.position[1][b] + seg.shift[1], p.position[2][b] + seg.shift[2]};
+          const Vec3 r = sub(xm, xb);
+          const double dist = norm(r);
+          if (dist >= R) continue;
+          const int side = s.near[b].closest.side;
+          // The node as seen from b's side: nothing of the mesh may lie in between.
+          const Vec3 target{xm[0] + side * tiny * nm[0], xm[1] + side * tiny * nm[1], xm[2] + side * tiny * nm[2]};
+          if (crosses_any(mesh_, s.candidates[b], face_normal_, face_offset_, face_box_, xb, target)) continue;
+          const double w = W.value(static_cast<float>(dist));
+          const int k = side_index(side);
+          const double rho_b = fluid_.rest_density + p.density_excess[b];
+          sw[k] += w;
+          sp[k] += p.pressure[b] * w;
+          for (int d = 0; d < 3; ++d) {
+            srr[k][d] += rho_b * r[d] * w;
+            sv[k][d] += p.velocity[d][b] * w;
+          }
+        }
+      }
+      for (int k = 0; k < 2; ++k) {
+        SideState& st = s.state[j].side[static_cast<std::size_t>(k)];
+        st.weight = sw[k];
+        if (sw[k] > 0) {
+          // Adami, Hu & Adams 2012, eq. 27, with the wall's acceleration (if enabled).
+          double pw = sp[k];
+          for (int d = 0; d < 3; ++d) pw += (fluid_.gravity[d] - am[d]) * srr[k][d];
+          st.pressure = pw / sw[k];
+          st.velocity = {sv[k][0] / sw[k], sv[k][1] / sw[k], sv[k][2] / sw[k]};
+        } else {
+          st.pressure = fluid_.background_pressure;
+          st.velocity = dyn_.v[j];
+        }
+      }
+    }
+  });
+}
+
+void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
+  auto& s = dyn_;
+  const double dp = fluid_.particle_spacing;
+  const double R = fluid_.support_radius();
+  const double delta = settings_.virtual_spacing_ratio * dp;
+  const int layers = static_cast<int>(std::ceil(R / delta));
+  const double rho0 = fluid_.rest_density;
+  const double mass_a = fluid_.particle_mass();
+  const double mass_v = rho0 * delta * delta * delta;
+  const double two_mu = 2.0 * fluid_.dynamic_viscosity;
+  const double alpha_c0 = fluid_.artificial_viscosity * fluid_.sound_speed;
+  const double h = fluid_.smoothing_length();
+  const double eta2 = 0.01 * h * h;
+  const LinearMieGruneisen eos{rho0, fluid_.sound_speed};
+  const bool with_kernel_sum = p.kernel_sum.size() == p.size();
+  if (s.state.size() != node_count_) s.state.assign(node_count_, NodeState{});
+
+  const int threads = omp_get_max_threads();
+  std::vector<Vec3> per_thread(static_cast<std::size_t>(threads) * node_count_, Vec3{0, 0, 0});
+  const auto count = static_cast<std::ptrdiff_t>(p.size());
+  with_kernel<3>(fluid_.kernel, h, [&](const auto& W) {
+#pragma omp parallel
+    {
+      Vec3* forces = per_thread.data() + static_cast<std::size_t>(omp_get_thread_num()) * node_count_;
+      std::vector<double> side_a;  // signed distance of the particle from each candidate's plane
+#pragma omp for schedule(dynamic, 16)
+      for (std::ptrdiff_t aa = 0; aa < count; ++aa) {
+        const auto a = static_cast<std::size_t>(aa);
+        if (p.kind[a] != Kind::fluid || !s.near[a].near) continue;
+        const ClosestPoint3& c = s.near[a].closest;
+        const auto& cand = s.candidates[a];
+        const Vec3 xa = position_of(p, a);
+        // Lattice axes: n from the closest point towards the particle (turns smoothly round a
+        // free edge), t1 and t2 across it.
+        Vec3 n = sub(xa, c.point);
+        const double nl = norm(n);
+        if (nl > 1e-9 * dp) {
+          n = {n[0] / nl, n[1] / nl, n[2] / nl};
+        } else {
+          n = face_normal_[c.triangle];
+          n = {c.side * n[0], c.side * n[1], c.side * n[2]};
+        }
+        const int least = std::abs(n[0]) <= std::abs(n[1]) && std::abs(n[0]) <= std::abs(n[2]) ? 0 : (std::abs(n[1]) <= std::abs(n[2]) ? 1 : 2);
+        Vec3 e{0, 0, 0};
+        e[static_cast<std::size_t>(least)] = 1.0;
+        Vec3 t1 = cross(n, e);
+        const double t1l = norm(t1);
+        t1 = {t1[0] / t1l, t1[1] / t1l, t1[2] / t1l};
+        const Vec3 t2 = cross(n, t1);
+        side_a.resize(cand.size());
+        for (std::size_t k = 0; k < cand.size(); ++k) side_a[k] = dot(face_normal_[cand[k]], xa) - face_offset_[cand[k]];
+        const int k_side = side_index(c.side);
+        const double rho_a = rho0 + p.density_excess[a];
+        const double inv_a = 1.0 / rho_a;
+        const double p_a = p.pressure[a];
+        const Vec3 va{p.velocity[0][a], p.velocity[1][a], p.velocity[2][a]};
+        const Vec3 vva{p.viscous_velocity[0][a], p.viscous_velocity[1][a], p.viscous_velocity[2][a]};
+        double acc[3] = {0, 0, 0}, cont = 0, csum = 0, cg[3] = {0, 0, 0};
+        std::vector<std::uint32_t> one(1);
+        const double first_depth = settings_.particle_aligned_layers ? delta - std::fmod(nl, delta) : 0.5 * delta;
+        // Layers in front of the tangent plane too: on the concave side of a curved leaflet the
+        // shadow reaches in front of it (R^2 / 2 rho_c: 0.4 dp at the sector's belly); the
+        // shadow test keeps only the points behind the mesh.
+        const int first_layer = settings_.lattice_in_front ? 1 - layers : 1;
+        for (int l = first_layer; l <= layers; ++l) {
+          const double depth = first_depth + (l - 1) * delta;
+          if (depth <= -nl) continue;  // not beyond the particle's own position
+          for (int i = -layers; i <= layers; ++i)
+            for (int j = -layers; j <= layers; ++j) {
+              Vec3 xv;
+              for (int d = 0; d < 3; ++d) xv[d] = c.point[d] + i * delta * t1[d] + j * delta * t2[d] - depth * n[d];
+              const Vec3 r = sub(xa, xv);
+              const double r2 = dot(r, r);
+              if (r2 >= R * R) continue;
+              // In the shadow: the segment from the particle to the point meets the mesh; the
+              // wall point q where it does carries the state. The candidates come nearest
+              // first, so the first hit is the one by the closest point (on a folded mesh
+              // the segment may meet it twice; the nearer triangle is the one in between).
+              std::optional<Crossing3> hit;
+              for (std::size_t k = 0; k < cand.size() && !hit; ++k) {
+                const std::uint32_t t = cand[k];
+                const double sv = dot(face_normal_[t], xv) - face_offset_[t];
+                if (!may_meet(face_box_[t], side_a[k], sv, xa, xv)) continue;
+                one[0] = t;
+                hit = first_crossing(mesh_, one, xa, xv);
+              }
+              if (!hit) continue;
+              const std::size_t t = hit->triangle;
+              const auto& tri = mesh_.triangles[t];
+              const int plane = triangle_plane_[t];
+              Vec3 q{0, 0, 0}, vw{0, 0, 0}, aw{0, 0, 0}, ve{0, 0, 0};
+              double p_v = 0;
+              for (int k = 0; k < 3; ++k) {
+                const double w = hit->barycentric[static_cast<std::size_t>(k)];
+                const std::uint32_t m = tri[static_cast<std::size_t>(k)];
+                const SideState& st = s.state[origin_node_[m]].side[static_cast<std::size_t>(k_side)];
+                p_v += w * st.pressure;
+                const Vec3 vst = reflect_vector(plane, st.velocity);
+                for (int d = 0; d < 3; ++d) {
+                  q[d] += w * mesh_.position[m][d];
+                  vw[d] += w * mesh_velocity_[m][d];
+                  aw[d] += w * mesh_acceleration_[m][d];
+                  ve[d] += w * vst[d];
+                }
+              }
+              if (!settings_.wall_acceleration_in_pressure) aw = {0, 0, 0};
+              for (int d = 0; d < 3; ++d) p_v += rho0 * (fluid_.gravity[d] - aw[d]) * (xv[d] - q[d]);
+              Vec3 vv_v;
+              for (int d = 0; d < 3; ++d) vv_v[d] = 2.0 * vw[d] - ve[d];  // no-slip
+              const double inv_v = 1.0 / (rho0 + eos.density_excess(p_v - fluid_.background_pressure));
+              const double dist = std::sqrt(r2);
+              const double F = W.gradient_factor(static_cast<float>(dist));
+              const double wv = W.value(static_cast<float>(dist));
+              const double inv_rr = inv_a * inv_v;
+              const double vdx = (va[0] - vw[0]) * r[0] + (va[1] - vw[1]) * r[1] + (va[2] - vw[2]) * r[2];
+              double radial = -(p_a + p_v) * inv_rr;
+              if (alpha_c0 > 0) radial += alpha_c0 * h * std::min(vdx, 0.0) / (r2 + eta2) * 0.5 * (inv_a + inv_v);
+              radial *= F;
+              const double viscous = two_mu * inv_rr * F;
+              Vec3 da;
+              for (int d = 0; d < 3; ++d) da[d] = mass_v * (radial * r[d] + viscous * (vva[d] - vv_v[d]));
+              for (int d = 0; d < 3; ++d) acc[d] += da[d];
+              cont += mass_v * vdx * F;
+              csum += mass_v * wv * inv_v;
+              for (int d = 0; d < 3; ++d) cg[d] += mass_v * F * r[d] * inv_v;
+              // Action = reaction onto the nodes of the triangle seen, from the gauge pressure
+              // p - p_b (docs/thin-leaflet.md, "Coupled runs"); a load seen on a mirror image
+              // is the mirror fluid's load on the real leaflet, reflected back.
+              const double gauge = 2.0 * fluid_.background_pressure * inv_rr * F * mass_v;
+              Vec3 load;
+              for (int d = 0; d < 3; ++d) load[d] = -mass_a * (da[d] + gauge * r[d]);
+              load = reflect_vector(plane, load);
+              for (int k = 0; k < 3; ++k) {
+                const double w = hit->barycentric[static_cast<std::size_t>(k)];
+                Vec3& f = forces[origin_node_[tri[static_cast<std::size_t>(k)]]];
+                for (int d = 0; d < 3; ++d) f[d] += w * load[d];
+              }
+            }
+        }
+        for (int d = 0; d < 3; ++d) p.acceleration[d][a] += static_cast<float>(acc[d]);
+        p.density_rate[a] += static_cast<float>(cont);
+        if (with_kernel_sum) {
+          p.kernel_sum[a] += static_cast<float>(csum);
+          for (int d = 0; d < 3; ++d) p.kernel_sum_gradient[d][a] += static_cast<float>(cg[d]);
+        }
+      }
+    }
+  });
+  s.force.assign(node_count_, Vec3{0, 0, 0});
+  for (int th = 0; th < threads; ++th)
+    for (std::size_t m = 0; m < node_count_; ++m)
+      for (int d = 0; d < 3; ++d) s.force[m][d] += per_thread[static_cast<std::size_t>(th) * node_count_ + m][d];
+}
+
+bool ThinWallModel3D::accept_shift(const Particles<3>& p, std::size_t i, const Vec<3>& shift) {
+  const auto& s = dyn_;
+  if (i >= s.near.size() || !s.near[i].near) return true;
+  const Vec3 x = position_of(p, i);
+  const Vec3 y{x[0] + shift[0], x[1] + shift[1], x[2] + shift[2]};
+  bool ok = !crosses_any(mesh_, s.candidates[i], face_normal_, face_offset_, face_box_, x, y);
+  if (ok) {
+    const double after = closest_point(mesh_, s.candidates[i], y).distance;
+    ok = !(after < clearance_ && after < s.near[i].closest.distance);
+  }
+  if (!ok) {
+#pragma omp atomic
+    ++dyn_.counters.rejected_shifts;
+  }
+  return ok;
+}
+
+void ThinWallModel3D::node_forces(std::span<Vec<3>> forces) const {
+  if (forces.size() != node_count_)
+    throw std::invalid_argument(fmt::format("thin wall node_forces: {} entries given: needs one per node ({})", forces.size(), node_count_));
+  for (std::size_t j = 0; j < node_count_; ++j) forces[j] = j < dyn_.force.size() ? dyn_.force[j] : Vec3{0, 0, 0};
+}
+
+Vec3 ThinWallModel3D::total_force() const {
+  Vec3 total{0, 0, 0};
+  for (const auto& f : dyn_.force)
+    for (int d = 0; d < 3; ++d) total[d] += f[d];
+  return total;
+}
+
+std::size_t ThinWallModel3D::near_count() const {
+  std::size_t n = 0;
+  for (const auto& w : dyn_.near) n += w.near ? 1 : 0;
+  return n;
+}
+
+void ThinWallModel3D::save_checkpoint() { checkpoint_ = dyn_; }
+
+void ThinWallModel3D::restore_checkpoint() {
+  if (!checkpoint_) throw std::logic_error("thin wall 3D restore_checkpoint: no checkpoint was saved");
+  dyn_ = *checkpoint_;
+  place_mesh();
+}
+
+std::unique_ptr<ImmersedSurfaceModel<3>> make_thin_wall_model_3d(const ImmersedSurfaceGeometry<3>& geometry,
+                                                                 const FluidSettings<3>& fluid,
+                                                                 const valvefsi::cases::FluidThinWalls& walls) {
+  valvefsi::cases::FluidThinWalls checked = walls;
+  const bool spacing_given = walls.has_virtual_spacing_ratio();
+  apply_field_limits(checked, "fluid case", "fluid.thin_walls");
+  ThinWall3DSettings settings;
+  if (spacing_given) settings.virtual_spacing_ratio = checked.virtual_spacing_ratio();
+  settings.clearance_ratio = checked.clearance_ratio();
+  settings.wall_acceleration_in_pressure = checked.wall_acceleration_in_pressure();
+  return std::make_unique<ThinWallModel3D>(geometry, fluid, settings);
+}
+
+}  // namespace valvefsi::fluid::thin_wall

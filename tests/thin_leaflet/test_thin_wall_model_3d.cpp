@@ -1,0 +1,125 @@
+// The 3D thin-wall model behind the hook (ThinWallModel3D), with exact answers: consistent
+// orientation of the solid's triangles, the mirror images in the fluid's symmetry planes
+// (a pair between a particle and a mirror image is blocked by the image leaflet), the checks
+// on the coupler's geometry, and action = reaction between the fluid and the nodes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "valvefsi/fluid/fluid_solver.hpp"
+#include "valvefsi/fluid/geometry.hpp"
+#include "valvefsi/fluid/thin_wall/scenes_3d.hpp"
+#include "valvefsi/fluid/thin_wall/thin_wall_model_3d.hpp"
+
+namespace valvefsi::fluid::thin_wall {
+namespace {
+
+FluidSettings<3> settings(double dp) {
+  FluidSettings<3> s;
+  s.particle_spacing = dp;
+  s.rest_density = 1000.0;
+  s.sound_speed = 20.0;
+  s.domain_lower = {-1, -1, -1};
+  s.domain_upper = {2, 2, 2};
+  return s;
+}
+
+// The unit square x = 0.5, y, z in [0, 1] (normal +x), cut into n x n cells.
+ImmersedSurfaceGeometry<3> membrane(int n) { return rectangle_mesh({0.5, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}, n, n); }
+
+TEST(ThinWallModel3D, OrientsTheSolidsTrianglesConsistently) {
+  std::vector<std::array<std::uint32_t, 3>> t{{0, 1, 2}, {0, 3, 2}, {4, 5, 6}};  // the second disagrees with the first
+  EXPECT_EQ(orient_consistently(t), 1u);
+  EXPECT_EQ(t[1], (std::array<std::uint32_t, 3>{0, 2, 3}));
+  EXPECT_EQ(t[2], (std::array<std::uint32_t, 3>{4, 5, 6}));  // a separate piece keeps its own
+  std::vector<std::array<std::uint32_t, 3>> branch{{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+  EXPECT_THROW(orient_consistently(branch), std::invalid_argument);
+}
+
+TEST(ThinWallModel3D, RefusesBadGeometry) {
+  const auto s = settings(0.1);
+  auto g = membrane(2);
+  g.nodes_per_cell = 2;
+  EXPECT_THROW(ThinWallModel3D(g, s, {}), std::invalid_argument);
+  g = membrane(2);
+  g.node_thickness[3] = 0.1;  // not below dp
+  EXPECT_THROW(ThinWallModel3D(g, s, {}), std::invalid_argument);
+  g = membrane(2);
+  g.cells[4] = 99;
+  EXPECT_THROW(ThinWallModel3D(g, s, {}), std::invalid_argument);
+  g = membrane(2);
+  g.cells[1] = g.cells[0];  // a triangle with no area
+  EXPECT_THROW(ThinWallModel3D(g, s, {}), std::invalid_argument);
+}
+
+TEST(ThinWallModel3D, MirrorImagesShareTheNodesOnThePlane) {
+  auto s = settings(0.1);
+  s.mirror_planes.push_back({{0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}});
+  const ThinWallModel3D model(membrane(4), s, {});
+  // 25 nodes, 5 on the plane y = 0: 20 image nodes; 32 triangles and their 32 images.
+  EXPECT_EQ(model.mesh().position.size(), 45u);
+  EXPECT_EQ(model.mesh().triangles.size(), 64u);
+  EXPECT_EQ(model.real_triangle_count(), 32u);
+  // The image keeps the sides: a point at y < 0 in front of the image (x > 0.5) is on side +1,
+  // and the line y = 0 is no free edge any more.
+  const auto c = closest_point(model.mesh(), {0.6, -0.3, 0.5});
+  EXPECT_EQ(c.side, 1);
+  EXPECT_NEAR(c.distance, 0.1, 1e-12);
+  EXPECT_FALSE(closest_point(model.mesh(), {0.6, 0.0, 0.5}).on_boundary);
+  EXPECT_TRUE(closest_point(model.mesh(), {0.6, 1.2, 0.5}).on_boundary);
+}
+
+TEST(ThinWallModel3D, APairWithAMirrorImageIsBlockedByTheImageLeaflet) {
+  for (const bool mirror : {false, true}) {
+    auto s = settings(0.05);  // support 0.13 m
+    if (mirror) s.mirror_planes.push_back({{0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}});
+    ThinWallModel3D model(membrane(10), s, {});
+    Particles<3> p;
+    p.add({0.45, 0.01, 0.5}, {0, 0, 0}, 0.0f, Kind::fluid);
+    // Its partner's image beyond the plane, on the other side of the membrane's image: the
+    // segment meets x = 0.5 at y = -0.02, outside the real membrane.
+    p.add({0.55, -0.05, 0.5}, {0, 0, 0}, 0.0f, Kind::mirror_fluid);
+    p.add({0.45, 0.06, 0.5}, {0, 0, 0}, 0.0f, Kind::fluid);  // same side as the first
+    model.classify(p);
+    ASSERT_TRUE(model.near_surface(0));
+    ASSERT_TRUE(model.near_surface(1));
+    EXPECT_EQ(model.blocked(0, 1, p), mirror);
+    EXPECT_EQ(model.blocked(1, 0, p), mirror);
+    EXPECT_FALSE(model.blocked(0, 2, p));
+  }
+}
+
+TEST(ThinWallModel3D, NodeForcesAreMinusTheForceOnTheFluid) {
+  // A block of water round a 0.2 m membrane, 2 kPa on its left and 1 kPa on its right: every
+  // fluid-fluid pair force cancels, so the fluid's total momentum change is the surface's.
+  const double dp = 0.02;
+  FluidSettings<3> s = settings(dp);
+  s.domain_lower = {-0.5, -0.5, -0.5};
+  s.domain_upper = {0.5, 0.5, 0.5};
+  SceneGeometry<3> scene;
+  scene.fluid.push_back({{-0.16, -0.16, -0.16}, {0.16, 0.16, 0.16}, {}, [](const Vec<3>& x) { return x[0] < 0 ? 2000.0 : 1000.0; }});
+  const auto g = rectangle_mesh({0.0, -0.1, -0.1}, {0.0, 0.2, 0.0}, {0.0, 0.0, 0.2}, 10, 10);
+  auto model = std::make_unique<ThinWallModel3D>(g, s, ThinWall3DSettings{});
+  const ThinWallModel3D* m = model.get();
+  FluidSolver<3> solver(s, fill_particles<3>(scene, s), {}, std::move(model));
+  const auto& p = solver.particles();
+  Vec3 fluid{0, 0, 0};
+  double magnitude = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.kind[i] != Kind::fluid) continue;
+    for (int d = 0; d < 3; ++d) {
+      fluid[d] += s.particle_mass() * p.acceleration[d][i];
+      magnitude += s.particle_mass() * std::abs(p.acceleration[d][i]);
+    }
+  }
+  const Vec3 surface = m->total_force();
+  std::printf("force on the fluid %.6g %.6g %.6g N, on the nodes %.6g %.6g %.6g N (sum |m a| %.4g N)\n", fluid[0], fluid[1],
+              fluid[2], surface[0], surface[1], surface[2], magnitude);
+  for (int d = 0; d < 3; ++d) EXPECT_NEAR(surface[d], -fluid[d], 1e-5 * magnitude);
+  // The higher pressure is on the left, the membrane's side -1: the load points along +x.
+  EXPECT_GT(surface[0], 0.0);
+}
+
+}  // namespace
+}  // namespace valvefsi::fluid::thin_wall

@@ -3,6 +3,7 @@
 
     /usr/bin/python3 scripts/run_case.py CASE [--output DIR] [--fluid-ranks N] [--fe-only]
         [--fluid-exe PATH] [--solid-exe PATH] [--coupler-exe PATH] [--build-dir DIR] [--grace S]
+        [--restart RUN/restart]
 
 Each program is started as `<executable> <case arguments...> --case CASE --output DIR` (the
 solid also gets `--fe-only` with --fe-only), with VALVEFSI_COUPLER_ENDPOINT set so that all
@@ -142,6 +143,9 @@ def main():
     parser.add_argument("--solid-exe", help="solid program (overrides the case)")
     parser.add_argument("--coupler-exe", help="coupler program (overrides the case)")
     parser.add_argument("--build-dir", type=Path, default=REPO / "build", help="where bare program names are found")
+    parser.add_argument("--restart", type=Path,
+                        help="continue from restart data: a run's restart/ folder or one restart/t_<time>/ folder "
+                             "(the case's coupling.restart_interval_s writes them)")
     parser.add_argument("--grace", type=float, default=5.0, help="seconds between SIGTERM and SIGKILL when stopping")
     args = parser.parse_args()
 
@@ -169,8 +173,11 @@ def main():
         return [find_executable(name, build_dir, role)] + plan[role]["arguments"] + common
 
     commands = []
+    if args.restart and fe_only:
+        fail("--restart is for coupled runs (FE-only runs are short enough to repeat)")
     if not fe_only:
-        commands.append(("coupler", [coupler] + common))
+        restart = ["--restart", str(args.restart.resolve())] if args.restart else []
+        commands.append(("coupler", [coupler] + common + restart))
     solid = command_for("solid", args.solid_exe)
     commands.append(("solid", solid + (["--fe-only"] if fe_only else [])))
     if not fe_only:

@@ -32,7 +32,7 @@ coupling {{
     argv.insert(argv.end(), common.begin(), common.end());
     return argv;
   };
-  coupler = std::make_unique<ChildProcess>(with({coupler_exe()}, {}), dir / "coupler.log");
+  coupler = std::make_unique<ChildProcess>(with({coupler_exe()}, spec.coupler_args), dir / "coupler.log");
   solid = std::make_unique<ChildProcess>(with({standin_exe(spec.solid)}, spec.solid_args), dir / "solid.log");
   if (spec.start_fluid) {
     fluid = std::make_unique<ChildProcess>(with({standin_exe(spec.fluid)}, spec.fluid_args), dir / "fluid.log");

@@ -30,6 +30,7 @@ struct RunSpec {
   std::vector<std::string> solid_args;
   bool start_fluid = true;
   std::string endpoint;             // empty: ipc://<folder>/c.ipc
+  std::vector<std::string> coupler_args;  // e.g. {"--restart", folder}
 };
 
 class CoupledRun {

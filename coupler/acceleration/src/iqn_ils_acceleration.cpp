@@ -1,10 +1,13 @@
 #include "iqn_ils_acceleration.hpp"
 
-#include "constant_relaxation.hpp"
+#include <fmt/format.h>
 
 #include <Eigen/QR>
 
 #include <algorithm>
+#include <stdexcept>
+
+#include "constant_relaxation.hpp"
 
 namespace valvefsi::coupling {
 
@@ -19,6 +22,28 @@ void IqnIlsAcceleration::begin_window() {
 void IqnIlsAcceleration::end_window() {
   for (Column& c : columns_) ++c.windows_ago;
   std::erase_if(columns_, [&](const Column& c) { return c.windows_ago > options_.reused_windows; });
+  has_previous_ = false;
+}
+
+// Per column: residual change, output change (vectors) and its age in windows (integers).
+CarriedState IqnIlsAcceleration::carried_state() const {
+  CarriedState state;
+  for (const Column& c : columns_) {
+    state.vectors.push_back(c.residual_change);
+    state.vectors.push_back(c.output_change);
+    state.integers.push_back(c.windows_ago);
+  }
+  return state;
+}
+
+void IqnIlsAcceleration::restore_carried_state(const CarriedState& state) {
+  if (state.vectors.size() != 2 * state.integers.size()) {
+    throw std::invalid_argument(fmt::format("IQN-ILS restart state: {} vectors for {} columns; expected two per column",
+                                            state.vectors.size(), state.integers.size()));
+  }
+  columns_.clear();
+  for (std::size_t k = 0; k < state.integers.size(); ++k)
+    columns_.push_back({state.vectors[2 * k], state.vectors[2 * k + 1], static_cast<int>(state.integers[k])});
   has_previous_ = false;
 }
 

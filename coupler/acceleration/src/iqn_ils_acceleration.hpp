@@ -20,6 +20,8 @@ class IqnIlsAcceleration final : public Acceleration {
   void begin_window() override;
   Eigen::VectorXd next_input(const Eigen::VectorXd& input, const Eigen::VectorXd& output) override;
   void end_window() override;
+  CarriedState carried_state() const override;
+  void restore_carried_state(const CarriedState& state) override;
 
   // For tests and logs: the columns the last update used (after filtering).
   int column_count() const { return static_cast<int>(columns_.size()); }

@@ -78,3 +78,23 @@ double acoustic_mass_ratio(double fluid_density, double sound_speed, double wind
 }
 
 }  // namespace valvefsi::coupling::model
+
+namespace valvefsi::coupling::model {
+
+Eigen::VectorXd AcousticColumnFluid::state_values() const {
+  const Eigen::Index cells = state_.right_going.size();
+  Eigen::VectorXd values(2 + 2 * cells);
+  values << state_.time, state_.wall_pressure, state_.right_going, state_.left_going;
+  return values;
+}
+
+void AcousticColumnFluid::load_state_values(const Eigen::VectorXd& values) {
+  const Eigen::Index cells = state_.right_going.size();
+  require_state_size("AcousticColumnFluid", values, 2 + 2 * cells);
+  state_.time = values(0);
+  state_.wall_pressure = values(1);
+  state_.right_going = values.segment(2, cells);
+  state_.left_going = values.segment(2 + cells, cells);
+}
+
+}  // namespace valvefsi::coupling::model

@@ -36,3 +36,14 @@ Eigen::VectorXd PistonSolid::advance(double window, const Eigen::VectorXd& fluid
 }
 
 }  // namespace valvefsi::coupling::model
+
+namespace valvefsi::coupling::model {
+
+void require_state_size(const char* model, const Eigen::VectorXd& values, Eigen::Index expected) {
+  if (values.size() != expected) {
+    throw std::invalid_argument(std::string(model) + ": a restart state of " + std::to_string(values.size()) +
+                                " values; this model has " + std::to_string(expected));
+  }
+}
+
+}  // namespace valvefsi::coupling::model

@@ -72,6 +72,7 @@ void Participant::handshake() {
   handshake->set_solver_version(options_.solver_version);
   handshake->set_spatial_dimension(static_cast<std::uint32_t>(options_.spatial_dimension));
   if (options_.can_checkpoint) handshake->add_capabilities("checkpoint");
+  if (options_.can_restart) handshake->add_capabilities("restart");
   for (const auto& capability : options_.extra_capabilities) handshake->add_capabilities(capability);
   channel_->send(kCoupler, std::move(hello));
 
@@ -83,6 +84,8 @@ void Participant::handshake() {
   session_.coupler_version = accepted.coupler_version();
   session_.scheme = accepted.scheme();
   session_.implicit = accepted.implicit();
+  session_.restart_directory = accepted.restart_directory();
+  session_.restart_time = accepted.restart_time();
   if (accepted.heartbeat_interval_s() > 0.0 && accepted.peer_timeout_s() > 0.0) {
     LivenessSettings liveness = options_.liveness;
     liveness.heartbeat_interval = std::chrono::duration<double>(accepted.heartbeat_interval_s());
@@ -196,12 +199,19 @@ bool Participant::next_window(Window& window) {
   require_stage(Stage::initialized, "next_window()");
   window.save_checkpoint = false;
   window.restore_checkpoint = false;
+  window.write_restart = false;
+  window.restart_directory.clear();
   const std::string sender = "the coupler";
   for (;;) {
     const auto message = channel_->receive_from(kCoupler);
     switch (message.body_case()) {
       case protocol::Envelope::kCheckpointSave: window.save_checkpoint = true; break;
       case protocol::Envelope::kCheckpointRestore: window.restore_checkpoint = true; break;
+      case protocol::Envelope::kRestartWrite:
+        if (!options_.can_restart) protocol_violation(message, "no restart_write (it has no 'restart' capability)");
+        window.write_restart = true;
+        window.restart_directory = message.restart_write().directory();
+        break;
       case protocol::Envelope::kConverged: {
         const auto& converged = message.converged();
         if (!converged.converged()) {

@@ -1,6 +1,6 @@
 // coupler --case FILE [--output DIR] [--endpoint E] [--heartbeat-interval S] [--peer-timeout S]
 //         [--startup-timeout S]
-//         [--describe-launch]
+//         [--restart FOLDER] [--describe-launch]
 // Couples the fluid and the solid of a case (its `coupling` part), see docs/coupling.md.
 
 #include <CLI/CLI.hpp>
@@ -11,6 +11,7 @@
 #include "valvefsi/case/case_loader.hpp"
 #include "valvefsi/coupler/coupler_run.hpp"
 #include "valvefsi/coupler/launch_plan.hpp"
+#include "valvefsi/coupler/restart_points.hpp"
 #include "valvefsi/coupling/transport_errors.hpp"
 
 int main(int argc, char** argv) {
@@ -30,6 +31,10 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--startup-timeout", startup_timeout, "seconds the participants get to connect (overrides the case)")
       ->check(CLI::PositiveNumber);
+  std::string restart;
+  app.add_option("--restart", restart,
+                 "continue a run from restart data: a run's restart/ folder (its newest complete point) or one "
+                 "restart/t_<time>/ folder");
   bool describe_launch = false;
   app.add_flag("--describe-launch", describe_launch,
                "print the programs, arguments, output folder and endpoint of the case as JSON and exit "
@@ -52,6 +57,15 @@ int main(int argc, char** argv) {
     if (peer_timeout > 0.0) settings.liveness.peer_timeout = std::chrono::duration<double>(peer_timeout);
     if (startup_timeout > 0.0) settings.liveness.startup_timeout = std::chrono::duration<double>(startup_timeout);
     valvefsi::coupling::check_liveness_settings(settings.liveness);
+    if (!restart.empty()) {
+      settings.restart_from = std::filesystem::absolute(valvefsi::coupler::resolve_restart_folder(restart));
+      settings.restart_time = valvefsi::coupler::restart_folder_time(settings.restart_from);
+      if (settings.restart_time >= settings.end_time) {
+        spdlog::error("coupler: --restart {}: the restart point t = {} s is not before run.end_time = {} s", restart,
+                      settings.restart_time, settings.end_time);
+        return valvefsi::coupling::kExitBadInput;
+      }
+    }
     return valvefsi::coupler::run_coupler(settings);
   } catch (const valvefsi::CaseError& error) {
     spdlog::error("coupler: {}", error.what());

@@ -55,6 +55,8 @@ CouplerSettings settings_from_case(const cases::Case& run_case, const std::files
   const std::filesystem::path series = coupling.series_file();
   settings.series_file = series.is_absolute() ? series : output_dir / series;
   settings.series_flush_rows = coupling.series_flush_rows();
+  settings.restart_interval = coupling.restart_interval_s();
+  settings.restart_keep = coupling.restart_keep();
   return settings;
 }
 

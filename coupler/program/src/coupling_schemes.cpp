@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "valvefsi/coupler/restart_points.hpp"
 #include "valvefsi/coupling/acceleration.hpp"
 
 namespace valvefsi::coupler {
@@ -130,12 +131,39 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
   SchemeSummary summary;
   Proposals proposals;
   double time = 0.0;
+  if (!settings.restart_from.empty()) {
+    const auto state = read_coupler_restart(settings.restart_from, session.solid_surface.positions.cols());
+    time = state.time;
+    summary.windows = state.windows;
+    summary.total_iterations = state.total_iterations;
+    summary.unconverged_windows = state.unconverged_windows;
+    solid = {state.solid_positions, state.solid_velocities};
+    previous_node_forces = state.previous_node_forces;
+    proposals = {state.fluid_proposal, state.solid_proposal};
+    if (acceleration) acceleration->restore_carried_state(state.acceleration);
+    spdlog::info("coupler: continuing from {} at t = {} s (window {})", settings.restart_from.string(), time, summary.windows);
+  }
   const double end_tolerance = kSliver * settings.window_size;
+  // Restart points: the first window start at or after each multiple of the interval.
+  auto next_restart_after = [&](double t) {
+    return (std::floor(t / settings.restart_interval * (1.0 + 1e-12)) + 1.0) * settings.restart_interval;
+  };
+  double next_restart = settings.restart_interval > 0.0 ? next_restart_after(time) : 0.0;
   while (settings.end_time - time > end_tolerance) {
     WindowSpan window;
     window.time = time;
     window.size = next_window_size(time, settings.end_time, settings.window_size, proposals.fluid, proposals.solid);
     window.index = summary.windows;
+    std::filesystem::path restart;
+    if (settings.restart_interval > 0.0 && time >= next_restart * (1.0 - 1e-12)) {
+      restart = restart_folder(settings.output_dir, time);
+      CouplerRestartState state{time, summary.windows, summary.total_iterations, summary.unconverged_windows,
+                                solid.positions, solid.velocities, previous_node_forces, proposals.fluid,
+                                proposals.solid, acceleration ? acceleration->carried_state() : coupling::CarriedState{}};
+      write_coupler_restart(restart, state);
+      exchange.send_restart_write(time, restart);
+      next_restart = next_restart_after(time);
+    }
     WindowRecord record;
     switch (settings.scheme) {
       case SchemeKind::serial_explicit: record = serial_explicit_window(exchange, window, solid, proposals); break;
@@ -145,6 +173,11 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
       case SchemeKind::serial_implicit:
         record = serial_implicit_window(exchange, settings, window, solid, *acceleration, proposals);
         break;
+    }
+    // Both participants answered this window, so both wrote their restart files before it.
+    if (!restart.empty()) {
+      mark_restart_complete(restart, settings.restart_keep);
+      spdlog::info("coupler: restart data at t = {} s in {}", window.time, restart.string());
     }
     observe(record);
     ++summary.windows;

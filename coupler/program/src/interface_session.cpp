@@ -106,6 +106,19 @@ InterfaceSession open_session(MessageChannel& channel, const CouplerSettings& se
       }
     }
   }
+  const bool restarts = settings.restart_interval > 0.0 || !settings.restart_from.empty();
+  if (restarts) {
+    for (const auto& [name, info] : {std::pair{kFluid, session.fluid}, std::pair{kSolid, session.solid}}) {
+      if (!has_capability(info, "restart")) {
+        throw ProtocolError(fmt::format(
+            "{} needs restart files, but {} ({}) has no 'restart' capability; set coupling.restart_interval_s = 0 "
+            "and run without --restart",
+            settings.restart_from.empty() ? fmt::format("coupling.restart_interval_s = {}", settings.restart_interval)
+                                          : fmt::format("--restart {}", settings.restart_from.string()),
+            who(name), info.solver_name));
+      }
+    }
+  }
   for (const auto& [name, partner] : {std::pair{kFluid, session.solid}, std::pair{kSolid, session.fluid}}) {
     protocol::Envelope accepted;
     auto* body = accepted.mutable_handshake_accepted();
@@ -117,6 +130,10 @@ InterfaceSession open_session(MessageChannel& channel, const CouplerSettings& se
     body->set_implicit(implicit);
     body->set_heartbeat_interval_s(settings.liveness.heartbeat_interval.count());
     body->set_peer_timeout_s(settings.liveness.peer_timeout.count());
+    if (!settings.restart_from.empty()) {
+      body->set_restart_directory(settings.restart_from.string());
+      body->set_restart_time(settings.restart_time);
+    }
     channel.send(name, std::move(accepted));
   }
 

@@ -95,6 +95,13 @@ void WindowExchange::send_checkpoint_save(double time) {
   send_both(envelope);
 }
 
+void WindowExchange::send_restart_write(double time, const std::filesystem::path& folder) {
+  protocol::Envelope envelope;
+  envelope.mutable_restart_write()->set_time(time);
+  envelope.mutable_restart_write()->set_directory(folder.string());
+  send_both(envelope);
+}
+
 void WindowExchange::send_checkpoint_restore(double time) {
   protocol::Envelope envelope;
   envelope.mutable_checkpoint_restore()->set_time(time);

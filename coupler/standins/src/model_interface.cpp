@@ -1,5 +1,7 @@
 #include "model_interface.hpp"
 
+#include "valvefsi/coupling/restart_file.hpp"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -27,6 +29,25 @@ coupling::InterfaceSurfaceData model_surface(const std::string& model, double ar
   surface.cells << 0, 0, 1, 2, 2, 3;
   surface.node_areas = Eigen::VectorXd::Constant(4, area / 4.0);
   return surface;
+}
+
+void write_model_restart(const coupling::Window& window, const coupling::Participant& participant,
+                         const coupling::model::ModelParticipant& model, const Eigen::VectorXd& wrapper) {
+  coupling::RestartWriter file(coupling::restart_file_path(window.restart_directory, participant.name()));
+  const Eigen::VectorXd state = model.state_values();
+  file.put("model_state", std::span<const double>(state.data(), static_cast<std::size_t>(state.size())));
+  file.put("wrapper_state", std::span<const double>(wrapper.data(), static_cast<std::size_t>(wrapper.size())));
+  file.commit();
+}
+
+Eigen::VectorXd read_model_restart(const coupling::Participant& participant, coupling::model::ModelParticipant& model) {
+  const auto& folder = participant.session().restart_directory;
+  if (folder.empty()) return {};
+  const coupling::RestartReader file(coupling::restart_file_path(folder, participant.name()));
+  const auto state = file.doubles("model_state");
+  model.load_state_values(Eigen::Map<const Eigen::VectorXd>(state.data(), static_cast<Eigen::Index>(state.size())));
+  const auto wrapper = file.doubles("wrapper_state");
+  return Eigen::Map<const Eigen::VectorXd>(wrapper.data(), static_cast<Eigen::Index>(wrapper.size()));
 }
 
 }  // namespace valvefsi::standins

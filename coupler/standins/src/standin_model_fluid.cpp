@@ -46,8 +46,9 @@ int main(int argc, char** argv) {
 
   std::unique_ptr<valvefsi::coupling::Participant> participant;
   return valvefsi::standins::run_guarded("standin_model_fluid", participant, [&] {
-    participant = std::make_unique<valvefsi::coupling::Participant>(valvefsi::standins::participant_options(
-        common, valvefsi::coupling::ParticipantRole::fluid, "standin_model_fluid/" + kind));
+    auto options = valvefsi::standins::participant_options(common, valvefsi::coupling::ParticipantRole::fluid, "standin_model_fluid/" + kind);
+    options.can_restart = true;  // the model's state fits in a restart file
+    participant = std::make_unique<valvefsi::coupling::Participant>(options);
     std::unique_ptr<model::ModelParticipant> fluid;
     if (kind == "incompressible") {
       fluid = std::make_unique<model::IncompressiblePistonFluid>(incompressible);
@@ -66,8 +67,18 @@ int main(int argc, char** argv) {
     const Eigen::Index points = reference.cols();
     double start_velocity = 0.0, end_velocity = 0.0;
     std::uint64_t current_window = 0;
+    if (const auto wrapper = valvefsi::standins::read_model_restart(*participant, *fluid); wrapper.size() > 0) {
+      start_velocity = wrapper(0);
+      end_velocity = wrapper(1);
+      current_window = static_cast<std::uint64_t>(wrapper(2));
+    }
     valvefsi::coupling::Window window;
     while (participant->next_window(window)) {
+      if (window.write_restart) {
+        valvefsi::standins::write_model_restart(
+            window, *participant, *fluid,
+            Eigen::Vector3d(start_velocity, end_velocity, static_cast<double>(current_window)));
+      }
       if (window.restore_checkpoint) fluid->restore_checkpoint();
       if (window.save_checkpoint) fluid->save_checkpoint();
       if (window.index != current_window) {  // the previous window is done: its end is our start

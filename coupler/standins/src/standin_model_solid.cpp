@@ -37,8 +37,9 @@ int main(int argc, char** argv) {
 
   std::unique_ptr<valvefsi::coupling::Participant> participant;
   return valvefsi::standins::run_guarded("standin_model_solid", participant, [&] {
-    participant = std::make_unique<valvefsi::coupling::Participant>(valvefsi::standins::participant_options(
-        common, valvefsi::coupling::ParticipantRole::solid, "standin_model_solid/" + kind));
+    auto options = valvefsi::standins::participant_options(common, valvefsi::coupling::ParticipantRole::solid, "standin_model_solid/" + kind);
+    options.can_restart = true;  // the model's state fits in a restart file
+    participant = std::make_unique<valvefsi::coupling::Participant>(options);
     const auto surface = valvefsi::standins::model_surface(kind, area);
     const Eigen::Index nodes = surface.positions.cols();
     std::unique_ptr<model::ModelParticipant> solid;
@@ -60,8 +61,11 @@ int main(int argc, char** argv) {
     };
     Eigen::VectorXd data = solid->current_data();
     participant->initialize_solid(surface, motion_of(data));
+    valvefsi::standins::read_model_restart(*participant, *solid);  // a restarted run: the saved state
+    data = solid->current_data();
     valvefsi::coupling::Window window;
     while (participant->next_window(window)) {
+      if (window.write_restart) valvefsi::standins::write_model_restart(window, *participant, *solid, Eigen::VectorXd());
       if (window.restore_checkpoint) solid->restore_checkpoint();
       if (window.save_checkpoint) solid->save_checkpoint();
       const Eigen::VectorXd input = kind == "piston" ? Eigen::VectorXd::Constant(1, window.loads.forces.row(0).sum())

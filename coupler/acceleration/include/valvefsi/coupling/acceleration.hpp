@@ -5,7 +5,9 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 #include <string_view>
 
 namespace valvefsi::coupling {
@@ -20,6 +22,13 @@ struct AccelerationOptions {
   double filter_epsilon = 1e-10;  // IQN-ILS QR filter
 };
 
+// What an acceleration carries from one window to the next (IQN-ILS's reused columns), so a
+// restarted run continues exactly; empty for schemes that start every window afresh.
+struct CarriedState {
+  std::vector<Eigen::VectorXd> vectors;
+  std::vector<std::int64_t> integers;
+};
+
 // Fixed-point iteration x = H(x) on the interface vector (the solid's motion), per window.
 class Acceleration {
  public:
@@ -28,6 +37,9 @@ class Acceleration {
   // input: x_k fed to the coupled operator; output: H(x_k). Returns x_{k+1}.
   virtual Eigen::VectorXd next_input(const Eigen::VectorXd& input, const Eigen::VectorXd& output) = 0;
   virtual void end_window() = 0;     // the window converged (IQN-ILS may keep columns)
+  // Between windows (after end_window, before begin_window): the carried state and back.
+  virtual CarriedState carried_state() const { return {}; }
+  virtual void restore_carried_state(const CarriedState& /*state*/) {}
 };
 
 // Throws std::invalid_argument for out-of-range options (naming the field, value and range).

@@ -10,10 +10,16 @@
 //   while (p.next_window(w)) {                    // blocks until the coupler opens a window
 //     if (w.restore_checkpoint) restore();        // implicit scheme: repeat this window
 //     if (w.save_checkpoint) save();              // implicit scheme: first pass of a window
+//     if (w.write_restart) write_restart(restart_file_path(w.restart_directory, p.name()));
 //     advance(w.time, w.size, w.loads / w.motion);
 //     p.complete_window(my_output, my_stable_step);
 //   }
 //   p.finalize();                                 // after writing output; or p.abort(reason)
+//
+// Restarts (options.can_restart): when session().restart_directory is not empty after the
+// initialize call, load your state from restart_file_path(that folder, name()) before the
+// first window (which starts at session().restart_time); valvefsi/coupling/restart_file.hpp
+// reads and writes such files.
 //
 // Faults: every call throws a TransportError (PeerLost, ProtocolError, RunAborted) whose
 // what() names who failed and why; exit with its exit_code(). While the solver computes
@@ -47,6 +53,7 @@ struct ParticipantOptions {
   std::string endpoint;            // resolve_endpoint(case.coupling().endpoint(), output_dir)
   int spatial_dimension = 3;       // 2 (z = 0) or 3; both participants must agree
   bool can_checkpoint = false;     // true if the solver can save/restore (implicit schemes)
+  bool can_restart = false;        // true if the solver writes and reads restart files
   std::vector<std::string> extra_capabilities;
   LivenessSettings liveness;       // until the coupler's settings arrive with the handshake
   bool exit_when_coupler_lost = true;
@@ -84,6 +91,10 @@ struct Window {
   std::uint32_t iteration = 0;   // 0 on the first pass, > 0 when the implicit scheme repeats it
   bool save_checkpoint = false;     // save your state (at `time`) before advancing
   bool restore_checkpoint = false;  // go back to the saved state before advancing
+  // Write your whole state at `time` (before advancing) into
+  // restart_file_path(restart_directory, participant name): a restarted run starts from it.
+  bool write_restart = false;
+  std::string restart_directory;
   // Input, at your points/nodes in your order:
   InterfaceMotion motion;  // fluid: markers at `time`, moving with `velocities` through the window
   InterfaceLoads loads;    // solid: nodal forces, constant over the window (window average)
@@ -97,6 +108,9 @@ struct SessionInfo {
   std::string coupler_version;
   std::string scheme;   // "serial-explicit", "parallel-explicit", "serial-implicit/iqn-ils", ...
   bool implicit = false;
+  // A restarted run: load your state from this folder before the first window (empty = t = 0).
+  std::string restart_directory;
+  double restart_time = 0.0;
 };
 
 class Participant {

@@ -28,6 +28,12 @@ struct CouplerSettings {
   std::filesystem::path output_dir;
   std::filesystem::path series_file;
   int series_flush_rows = 50;
+  // Restarts (docs/coupling.md, "Restarts"): write every restart_interval s (0 = never) into
+  // output_dir/restart/, keep the newest restart_keep; continue from restart_from if set.
+  double restart_interval = 0.0;
+  int restart_keep = 2;
+  std::filesystem::path restart_from;   // a complete restart folder (resolve_restart_folder)
+  double restart_time = 0.0;            // its time, read from the coupler's restart file
 };
 
 // "serial-explicit", "parallel-explicit", "serial-implicit/iqn-ils" (the acceleration is part

@@ -9,6 +9,8 @@
 
 #include <Eigen/Core>
 
+#include <filesystem>
+
 #include "valvefsi/coupler/interface_session.hpp"
 #include "valvefsi/coupling/message_channel.hpp"
 
@@ -52,6 +54,8 @@ class WindowExchange {
   [[nodiscard]] Eigen::Matrix3Xd loads_to_nodes(const Eigen::Matrix3Xd& point_forces) const;
   void send_checkpoint_save(double time);
   void send_checkpoint_restore(double time);
+  // Both participants write their state at `time` into `folder` before this window.
+  void send_restart_write(double time, const std::filesystem::path& folder);
   void send_converged(double time, std::uint32_t iterations, double residual, bool converged);
 
   [[nodiscard]] const InterfaceSession& session() const { return session_; }

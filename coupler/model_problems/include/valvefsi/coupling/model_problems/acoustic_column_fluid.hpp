@@ -38,6 +38,9 @@ class AcousticColumnFluid final : public ModelParticipant {
   void save_checkpoint() override { saved_ = state_; }
   void restore_checkpoint() override { state_ = saved_; }
   double time() const override { return state_.time; }
+  // [time, wall pressure, w+ (cells), w- (cells)]
+  Eigen::VectorXd state_values() const override;
+  void load_state_values(const Eigen::VectorXd& values) override;
   double cell_size() const;
   Eigen::VectorXd pressure() const;  // cell pressures, Pa
   Eigen::VectorXd velocity() const;  // cell velocities, m/s

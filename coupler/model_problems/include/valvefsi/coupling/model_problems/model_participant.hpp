@@ -10,6 +10,9 @@
 
 namespace valvefsi::coupling::model {
 
+// Checks a restart's value count; throws std::invalid_argument naming the model.
+void require_state_size(const char* model, const Eigen::VectorXd& values, Eigen::Index expected);
+
 class ModelParticipant {
  public:
   virtual ~ModelParticipant() = default;
@@ -22,6 +25,10 @@ class ModelParticipant {
   virtual void save_checkpoint() = 0;
   virtual void restore_checkpoint() = 0;
   virtual double time() const = 0;
+  // The full state as numbers and back (the stand-ins' restart files). load_state_values
+  // throws std::invalid_argument when the count does not fit this model.
+  virtual Eigen::VectorXd state_values() const = 0;
+  virtual void load_state_values(const Eigen::VectorXd& values) = 0;
 };
 
 }  // namespace valvefsi::coupling::model

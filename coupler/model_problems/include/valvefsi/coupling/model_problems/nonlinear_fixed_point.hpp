@@ -29,6 +29,11 @@ class NonlinearFixedPointFluid final : public ModelParticipant {
   void save_checkpoint() override { saved_time_ = time_; }
   void restore_checkpoint() override { time_ = saved_time_; }
   double time() const override { return time_; }
+  Eigen::VectorXd state_values() const override { return Eigen::VectorXd::Constant(1, time_); }
+  void load_state_values(const Eigen::VectorXd& values) override {
+    require_state_size("NonlinearFixedPointFluid", values, 1);
+    time_ = values(0);
+  }
 
  private:
   NonlinearFixedPoint problem_;
@@ -43,6 +48,11 @@ class NonlinearFixedPointSolid final : public ModelParticipant {
   void save_checkpoint() override { saved_time_ = time_; }
   void restore_checkpoint() override { time_ = saved_time_; }
   double time() const override { return time_; }
+  Eigen::VectorXd state_values() const override { return Eigen::VectorXd::Constant(1, time_); }
+  void load_state_values(const Eigen::VectorXd& values) override {
+    require_state_size("NonlinearFixedPointSolid", values, 1);
+    time_ = values(0);
+  }
 
  private:
   NonlinearFixedPoint problem_;

@@ -27,6 +27,13 @@ class PistonSolid final : public ModelParticipant {
   void save_checkpoint() override { saved_ = state_; }
   void restore_checkpoint() override { state_ = saved_; }
   double time() const override { return state_.time; }
+  Eigen::VectorXd state_values() const override {
+    return Eigen::Vector4d(state_.time, state_.displacement, state_.velocity, state_.acceleration);
+  }
+  void load_state_values(const Eigen::VectorXd& values) override {
+    require_state_size("PistonSolid", values, 4);
+    state_ = {values(0), values(1), values(2), values(3)};
+  }
   double acceleration() const { return state_.acceleration; }
 
  private:

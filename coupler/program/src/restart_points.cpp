@@ -36,15 +36,18 @@ void write_coupler_restart(const std::filesystem::path& folder, const CouplerRes
   file.put("fluid_proposal", state.fluid_proposal);
   file.put("solid_proposal", state.solid_proposal);
   file.put("acceleration_integers", std::span<const std::int64_t>(state.acceleration.integers));
-  file.put_integer("acceleration_vector_count", static_cast<std::int64_t>(state.acceleration.vectors.size()));
+  file.put_integer("acceleration_vector_count",
+                   static_cast<std::int64_t>(state.acceleration.vectors.size()));
   for (std::size_t k = 0; k < state.acceleration.vectors.size(); ++k) {
     const auto& v = state.acceleration.vectors[k];
-    file.put(fmt::format("acceleration_vector_{}", k), std::span<const double>(v.data(), static_cast<std::size_t>(v.size())));
+    file.put(fmt::format("acceleration_vector_{}", k),
+             std::span<const double>(v.data(), static_cast<std::size_t>(v.size())));
   }
   file.commit();
 }
 
-CouplerRestartState read_coupler_restart(const std::filesystem::path& folder, Eigen::Index solid_nodes) {
+CouplerRestartState read_coupler_restart(const std::filesystem::path& folder,
+                                         Eigen::Index solid_nodes) {
   const coupling::RestartReader file(coupling::restart_file_path(folder, "coupler"));
   CouplerRestartState state;
   state.time = file.scalar("time");
@@ -60,7 +63,8 @@ CouplerRestartState read_coupler_restart(const std::filesystem::path& folder, Ei
   const auto count = file.integer("acceleration_vector_count");
   for (std::int64_t k = 0; k < count; ++k) {
     const auto values = file.doubles(fmt::format("acceleration_vector_{}", k));
-    state.acceleration.vectors.emplace_back(Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size())));
+    state.acceleration.vectors.emplace_back(
+        Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size())));
   }
   return state;
 }
@@ -73,17 +77,20 @@ std::filesystem::path resolve_restart_folder(const std::filesystem::path& given)
     std::ifstream latest(given / kLatest);
     std::string name;
     if (!(latest >> name)) {
-      throw std::runtime_error(fmt::format(
-          "--restart {}: neither a complete restart folder (no {} mark) nor a run's restart/ folder (no {} file)",
-          given.string(), kComplete, kLatest));
+      throw std::runtime_error(
+          fmt::format("--restart {}: neither a complete restart folder (no {} mark) nor a run's "
+                      "restart/ folder (no {} file)",
+                      given.string(), kComplete, kLatest));
     }
     folder = given / name;
     if (!std::filesystem::exists(folder / kComplete))
-      throw std::runtime_error(fmt::format("--restart {}: {} names {}, which is not complete", given.string(), kLatest, folder.string()));
+      throw std::runtime_error(fmt::format("--restart {}: {} names {}, which is not complete",
+                                           given.string(), kLatest, folder.string()));
   }
   for (const char* who : {"coupler", "fluid", "solid"}) {
     if (!std::filesystem::exists(coupling::restart_file_path(folder, who)))
-      throw std::runtime_error(fmt::format("--restart {}: {} is missing", given.string(), coupling::restart_file_path(folder, who).string()));
+      throw std::runtime_error(fmt::format("--restart {}: {} is missing", given.string(),
+                                           coupling::restart_file_path(folder, who).string()));
   }
   return folder;
 }
@@ -108,7 +115,8 @@ void mark_restart_complete(const std::filesystem::path& folder, int keep) {
     if (!std::filesystem::exists(entry.path() / kComplete)) continue;
     complete.emplace_back(std::stod(name.substr(2)), entry.path());
   }
-  std::sort(complete.begin(), complete.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::sort(complete.begin(), complete.end(),
+            [](const auto& a, const auto& b) { return a.first > b.first; });
   for (std::size_t k = static_cast<std::size_t>(std::max(keep, 1)); k < complete.size(); ++k) {
     std::error_code ignored;
     std::filesystem::remove_all(complete[k].second, ignored);

@@ -15,14 +15,14 @@ namespace valvefsi::coupler {
 
 // Everything the coupling schemes carry from one window to the next.
 struct CouplerRestartState {
-  double time = 0.0;                   // start of the next window (s)
-  std::uint64_t windows = 0;           // windows completed
+  double time = 0.0;          // start of the next window (s)
+  std::uint64_t windows = 0;  // windows completed
   std::int64_t total_iterations = 0;
   std::uint64_t unconverged_windows = 0;
-  Eigen::Matrix3Xd solid_positions;    // the solid's nodes at `time`
+  Eigen::Matrix3Xd solid_positions;  // the solid's nodes at `time`
   Eigen::Matrix3Xd solid_velocities;
   Eigen::Matrix3Xd previous_node_forces;  // parallel explicit: the loads the solid gets next
-  double fluid_proposal = 0.0;         // window sizes proposed for the next window (s)
+  double fluid_proposal = 0.0;            // window sizes proposed for the next window (s)
   double solid_proposal = 0.0;
   coupling::CarriedState acceleration;
 };
@@ -30,7 +30,8 @@ struct CouplerRestartState {
 std::filesystem::path restart_folder(const std::filesystem::path& output_dir, double time);
 void write_coupler_restart(const std::filesystem::path& folder, const CouplerRestartState& state);
 // Throws std::runtime_error naming the file and entry, or when the solid's node count differs.
-CouplerRestartState read_coupler_restart(const std::filesystem::path& folder, Eigen::Index solid_nodes);
+CouplerRestartState read_coupler_restart(const std::filesystem::path& folder,
+                                         Eigen::Index solid_nodes);
 // The folder behind what a user gives: a restart folder (with a COMPLETE mark) or the
 // restart/ folder of a run (its LATEST). Throws std::runtime_error saying what is missing.
 std::filesystem::path resolve_restart_folder(const std::filesystem::path& given);

@@ -15,7 +15,8 @@
 namespace valvefsi::coupling {
 
 // <directory>/<participant>.restart.h5 ("fluid", "solid", "coupler").
-std::filesystem::path restart_file_path(const std::filesystem::path& directory, std::string_view participant);
+std::filesystem::path restart_file_path(const std::filesystem::path& directory,
+                                        std::string_view participant);
 
 class RestartWriter {
  public:
@@ -30,13 +31,17 @@ class RestartWriter {
   void put(std::string_view name, std::span<const float> values);
   void put(std::string_view name, std::span<const std::int64_t> values);
   void put(std::string_view name, double value) { put(name, std::span<const double>(&value, 1)); }
-  void put_integer(std::string_view name, std::int64_t value) { put(name, std::span<const std::int64_t>(&value, 1)); }
-  void put(std::string_view name, const Eigen::Matrix3Xd& columns);  // stored as 3 x n (column-major)
+  void put_integer(std::string_view name, std::int64_t value) {
+    put(name, std::span<const std::int64_t>(&value, 1));
+  }
+  void put(std::string_view name,
+           const Eigen::Matrix3Xd& columns);  // stored as 3 x n (column-major)
   // Closes the file and renames it to its real name.
   void commit();
 
  private:
-  void write(std::string_view name, const void* data, std::size_t count, bool integer, int element_bytes);
+  void write(std::string_view name, const void* data, std::size_t count, bool integer,
+             int element_bytes);
   std::filesystem::path file_, partial_;
   std::int64_t handle_ = -1;
   bool committed_ = false;
@@ -55,15 +60,16 @@ class RestartReader {
   // wrong kind, or (where a size is given) of the wrong size.
   std::vector<double> doubles(std::string_view name, std::ptrdiff_t expected_size = -1) const;
   std::vector<float> floats(std::string_view name, std::ptrdiff_t expected_size = -1) const;
-  std::vector<std::int64_t> integers(std::string_view name, std::ptrdiff_t expected_size = -1) const;
+  std::vector<std::int64_t> integers(std::string_view name,
+                                     std::ptrdiff_t expected_size = -1) const;
   double scalar(std::string_view name) const { return doubles(name, 1)[0]; }
   std::int64_t integer(std::string_view name) const { return integers(name, 1)[0]; }
   Eigen::Matrix3Xd matrix3x(std::string_view name, Eigen::Index expected_columns = -1) const;
   const std::filesystem::path& file() const { return file_; }
 
  private:
-  std::vector<unsigned char> read(std::string_view name, int kind, int element_bytes, std::ptrdiff_t expected_size,
-                                  std::size_t& count) const;
+  std::vector<unsigned char> read(std::string_view name, int kind, int element_bytes,
+                                  std::ptrdiff_t expected_size, std::size_t& count) const;
   std::filesystem::path file_;
   std::int64_t handle_ = -1;
 };

@@ -55,7 +55,9 @@ int run_case_at_rest(const std::string& case_file, const std::string& surface_fi
     settings.wall_acceleration_in_pressure = c.fluid().thin_walls().wall_acceleration_in_pressure();
     settings.particle_aligned_layers = aligned;
     settings.lattice_in_front = !behind_only;
-    auto m = std::make_unique<ThinWallModel3D>(read_surface(surface_file), solver.settings(), settings);
+    FluidSettings<3> fluid = solver.settings();
+    if (std::getenv("THIN_WALL_NO_IMAGES")) fluid.mirror_planes.clear();  // diagnostics: the leaflet without its images
+    auto m = std::make_unique<ThinWallModel3D>(read_surface(surface_file), fluid, settings);
     model = m.get();
     solver.set_immersed_surface(std::move(m));
   }

@@ -222,9 +222,6 @@ def main(argv=None) -> None:
     print(args.report)
 
 
-if __name__ == "__main__":
-    main()
-
 
 def opening_metrics(run_dir: Path, end_s: float = 0.06, plateau_from_s: float = 0.03) -> dict:
     """The opening alone (a run stopped at end_s, or the first end_s of a longer one), for the
@@ -252,3 +249,7 @@ def opening_metrics(run_dir: Path, end_s: float = 0.06, plateau_from_s: float = 
         stress = float(f["snapshots/peak_max_principal_stress"][()][sel].max())
     return {"opening_start_s": t10, "opening_end_s": t90, "rvot_s": t90 - t10, "r_open_m": r_open,
             "peak_log_strain": strain, "peak_stress_Pa": stress}
+
+
+if __name__ == "__main__":
+    main()

@@ -35,6 +35,12 @@ DEFAULT_PROGRAMS = {"fluid": "fluid_sph", "solid": "solid_fe", "coupler": "coupl
 ENDPOINT_VARIABLE = "VALVEFSI_COUPLER_ENDPOINT"
 
 
+# Exit code of a program that stopped because a peer aborted the run (coupler/transport).
+EXIT_ABORTED_BY_PEER = 5
+# Seconds the launcher waits after a failure for the others to relay it and end.
+RELAY_SETTLE_S = 2.0
+
+
 def fail(message, code=2):
     print(f"run_case: {message}", file=sys.stderr, flush=True)
     sys.exit(code)
@@ -213,7 +219,14 @@ def main():
             break
         failed = [p for p in programs if p.exit_code() not in (None, 0)]
         if failed:
-            first = min(failed, key=lambda p: p.ended_at)
+            # The others relay a failure within moments (Abort, exit 5): let them end, then name
+            # the one that did not merely relay it; a relay can exit before its origin.
+            settle_until = time.monotonic() + min(args.grace, RELAY_SETTLE_S)
+            while time.monotonic() < settle_until and any(p.exit_code() is None for p in programs):
+                time.sleep(0.05)
+            failed = [p for p in programs if p.exit_code() not in (None, 0)]
+            origins = [p for p in failed if p.exit_code() != EXIT_ABORTED_BY_PEER] or failed
+            first = min(origins, key=lambda p: p.ended_at)
             exit_code = first.exit_code()
             others = [p.role for p in programs if p is not first and p.exit_code() is None]
             print(f"run_case: {first.role} failed with exit code {exit_code}"

@@ -357,9 +357,10 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
                                         : state_.stable_step / std::sqrt(1.0 + options_.contact_stiffness_factor);
     // The step may fall at once but grows slowly: a step that follows the flutter of the
     // critical element up and down pumps energy into it (parametric excitation).
-    if (options_.max_time_step_growth > 0.0 && state_.last_step > 0.0) {
-      dt = std::min(dt, state_.last_step * (1.0 + options_.max_time_step_growth));
+    if (options_.max_time_step_growth > 0.0 && state_.uncut_step > 0.0) {
+      dt = std::min(dt, state_.uncut_step * (1.0 + options_.max_time_step_growth));
     }
+    state_.uncut_step = dt;
     // Land exactly on t_end; avoid a sliver step by splitting the last two evenly.
     const double remaining = t_end - state_.time;
     if (remaining <= dt) {

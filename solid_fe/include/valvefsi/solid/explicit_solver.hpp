@@ -49,6 +49,10 @@ struct SolverState {
   Eigen::Matrix3Xd contact_force;      // at `position`
   std::int64_t nodes_in_contact = 0;
   double last_step = 0;                // dt of the last step
+  // The last step before it was cut to land on a window's or an output's end. The growth limit
+  // starts from it: started from the cut step it ratcheted the step down window after window
+  // (coupled 2D valve: 0.04 us steps where 1 us was stable, 57 steps per 6.5 us window).
+  double uncut_step = 0;
   double stable_step = 0;              // current stable step estimate (safety applied)
   std::int64_t critical_element = -1;  // element that sets stable_step
   EnergyBalance energy;

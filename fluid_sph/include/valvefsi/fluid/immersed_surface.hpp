@@ -12,7 +12,10 @@
 //   add_surface_rates -> kick; shifting asks accept_shift for every near-surface particle.
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "valvefsi/fluid/cell_grid.hpp"
@@ -28,6 +31,13 @@ struct ImmersedSurfaceGeometry {
   int nodes_per_cell = D;                   // 2: segments, 3: triangles
   std::vector<std::uint32_t> cells;         // nodes_per_cell entries per cell, 0-based
   std::vector<double> node_thickness;       // m, one per node
+};
+
+// One entry of a model's restart state: a name unique within the model and its values
+// (integers stored as doubles, exact up to 2^53).
+struct NamedArray {
+  std::string name;
+  std::vector<double> values;
 };
 
 struct ImmersedSurfaceCounters {
@@ -78,6 +88,22 @@ class ImmersedSurfaceModel {
   // --- implicit coupling: repeat a window -------------------------------------------------
   virtual void save_checkpoint() = 0;
   virtual void restore_checkpoint() = 0;
+
+  // --- restart files (docs/coupling.md, "Restarts") --------------------------------------
+  // The model's whole state at a window's end, beyond the geometry the handshake gives again
+  // (node positions and velocities, the window's motion, counters, per-particle flags in
+  // the particle order of the moment: the fluid restores its particles in that same order),
+  // such that load_restart_state on a model built from the same geometry continues bit for
+  // bit. The fluid stores the arrays in its
+  // restart file under a prefix. std::nullopt: this model cannot restart (the default), and
+  // the fluid refuses to take part in restarts, saying so.
+  virtual std::optional<std::vector<NamedArray>> restart_state() const { return std::nullopt; }
+  // Called once, after the model is built and before the first step of the restarted run;
+  // throws std::runtime_error naming the array that is missing or of the wrong size.
+  virtual void load_restart_state(std::span<const NamedArray> arrays) {
+    (void)arrays;
+    throw std::runtime_error("this immersed-surface model cannot load restart state");
+  }
 };
 
 }  // namespace valvefsi::fluid

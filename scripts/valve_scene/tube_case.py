@@ -2,11 +2,17 @@
 (message valvefsi.cases.FluidCase, proto/fluid_case.proto).
 
 Choices (docs/valve-scene.md, "Tube"):
-- The gasket and the skirt are merged into one rigid ring (FluidAnnularDisk) between the stent
-  radius and the tube wall, from the gasket's upstream face up to the commissure tops. A skirt
-  as thin as the reference's would be a two-sided thin wall thinner than a particle, and a
-  skirt ending below the scalloped attachment line would let blood bypass the leaflets; the
-  ring avoids both and keeps the reference's "sudden contraction and expansion".
+- The gasket and the skirt below the annulus plane are one rigid ring (FluidAnnularDisk)
+  between the stent radius and the tube wall, from the gasket's upstream face to the annulus
+  plane z = 0 (the leaflet base): above it the open leaflets have blood behind them (a ring to
+  the commissure tops left none, and in 2D the open leaflets stuck to the stent).
+- Between the annulus plane and the scalloped attachment line the skirt must still seal, or
+  blood would bypass the leaflets under the scallops (~1.8 cm2 over the valve). No fluid
+  primitive follows a scallop, so the skirt is written as one solid box per lattice column
+  (x, y on the fluid lattice) with its centre at R <= r < R + skirt_layers * dp, from the ring
+  up to the attachment line's height at the column's azimuth: exactly the lattice points of a
+  scalloped cylinder wall skirt_layers particles thick (a kernel support, so the blood inside
+  and the blood in the sinus outside do not see each other through it).
 - The plates move with the flow (about 4 cm per cycle), so the tube extends beyond the
   outlet plate by the travel of all cycles; the inlet plate's travel fits in the upstream
   length.
@@ -15,12 +21,16 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .tube import TubeSetup
 from .valve_geometry import LEAFLET_COUNT, SECTOR_HALF_ANGLE, ValveParameters
 
 PLATE_LAYERS = 3                      # plate thickness in particle spacings
 STROKE_VOLUME_M3 = 60e-6              # generous: the reference's flow implies ~40 mL per beat
 VELOCITY_PROBE_DOWNSTREAM = 15e-3     # maximum velocity 15 mm downstream of the annulus (ref. Fig. 11c)
+SKIRT_LAYERS = 3                      # skirt thickness in particle spacings: ceil(2h / dp) at h = 1.3 dp
+SECTOR_SKIRT_MARGIN = math.radians(15.0)  # skirt columns kept beyond the sector's mirror planes
 
 
 def _vec(values) -> str:
@@ -44,6 +54,38 @@ def sector_mirror_planes() -> list[tuple[list[float], list[float]]]:
     a = SECTOR_HALF_ANGLE
     return [([0.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
             ([0.0, 0.0, 0.0], [math.sin(a), -math.cos(a), 0.0])]
+
+
+def skirt_columns(particle_spacing: float, lattice_origin_xy: tuple[float, float] = (0.0, 0.0),
+                  valve: ValveParameters | None = None, sector: bool = False,
+                  layers: int = SKIRT_LAYERS) -> list[tuple[float, float, float]]:
+    """The scalloped skirt above the annulus plane as lattice columns (x, y, top z): every
+    fluid-lattice column whose centre lies at R <= r < R + layers * dp, topped at the skirt's
+    top edge (tube.skirt_top_height: the attachment line, the commissure-tab top between tabs)
+    over the column's footprint (its azimuth +- dp / 2r). A sector keeps the columns within its wedge plus a margin."""
+    from .tube import skirt_top_height
+    valve = valve or ValveParameters()
+    dp = particle_spacing
+    R = valve.annulus_radius
+    outer = R + layers * dp
+    n = int(math.ceil(outer / dp)) + 2
+    ox, oy = lattice_origin_xy
+    columns = []
+    for i in range(-n, n + 1):
+        x = ox + (i + 0.5) * dp
+        for j in range(-n, n + 1):
+            y = oy + (j + 0.5) * dp
+            r = math.hypot(x, y)
+            if not R <= r < outer:
+                continue
+            azimuth = math.atan2(y, x)
+            if sector and not -SECTOR_SKIRT_MARGIN <= azimuth <= SECTOR_HALF_ANGLE + SECTOR_SKIRT_MARGIN:
+                continue
+            # the highest top over the column's footprint, so the narrow gap between two
+            # commissure tabs (0.5 mm, under a particle) is closed to the tab tops
+            footprint = np.linspace(azimuth - 0.5 * dp / r, azimuth + 0.5 * dp / r, 9)
+            columns.append((x, y, float(np.max(skirt_top_height(footprint, valve)))))
+    return columns
 
 
 def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = None,
@@ -70,6 +112,7 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
     tube_end = z_outlet + plate + travel + 2 * dp
     ring_start = setup.gasket_z - setup.gasket_thickness
     margin = 6 * dp
+    half_column = 0.45 * dp   # a column box holds exactly its lattice column's points
     # flow sections stay ahead of the inlet plate over all cycles (it travels ~5 cm per cycle)
     probes_z = {"upstream_tap": -setup.upstream_tap_distance,
                 "leaflet_base": 0.0, "commissure_tops": valve.commissure_height,
@@ -96,9 +139,15 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
         f"  fluid_blocks {{ box {{ lower: {_vec([-R_tube, -R_tube, z_inlet])} upper: {_vec([R_tube, R_tube, z_outlet])} }} }}",
         f"  # ISO 5840-3 tube, {setup.tube_diameter * 1e3:.1f} mm, extended past the outlet plate by its travel",
         f"  walls {{ tube {{ origin: {_vec([0, 0, tube_start])} axis: [0, 0, 1] length: {tube_end - tube_start:.6g} radius: {R_tube:.6g} }} }}",
-        "  # gasket + skirt: rigid ring from the stent radius to the tube wall, gasket to commissure tops",
+        "  # gasket + skirt below the annulus: rigid ring from the stent radius to the tube wall, gasket to",
+        "  # the annulus plane z = 0 (above it the open leaflets have blood behind them)",
         f"  walls {{ annular_disk {{ origin: {_vec([0, 0, ring_start])} axis: [0, 0, 1] "
-        f"thickness: {valve.commissure_height - ring_start:.6g} inner_radius: {valve.annulus_radius:.6g} outer_radius: {R_tube:.6g} }} }}",
+        f"thickness: {-ring_start:.6g} inner_radius: {valve.annulus_radius:.6g} outer_radius: {R_tube:.6g} }} }}",
+        f"  # scalloped skirt from the annulus plane to the attachment line, {SKIRT_LAYERS} particles thick:",
+        "  # one solid box per fluid-lattice column (no primitive follows a scallop; tube_case.py)",
+        *[f"  walls {{ solid_box {{ lower: {_vec([x - half_column, y - half_column, ring_start])} "
+          f"upper: {_vec([x + half_column, y + half_column, top])} }} }}"
+          for x, y, top in skirt_columns(dp, (0.0, 0.0), valve, sector)],
         "  # inlet plate: left-ventricular pressure",
         "  plates {",
         f"    shape {{ annular_disk {{ origin: {_vec([0, 0, z_inlet - plate])} axis: [0, 0, 1] thickness: {plate:.6g} outer_radius: {R_tube:.6g} }} }}",

@@ -69,3 +69,70 @@ class FluidBlock(unittest.TestCase):
         area = math.pi * 0.0184 ** 2
         # two strokes of 60 mL move the outlet plate 0.113 m beyond its start at 0.110 m
         self.assertGreater(start + length, 0.110 + 2 * 60e-6 / area)
+
+
+def _walls(text):
+    """The fluid block's ring (annular disks other than plates) and solid boxes, parsed."""
+    import re
+    num = r"(-?[\d.eE+-]+)"
+    vec = rf"\[{num}, {num}, {num}\]"
+    rings = [tuple(map(float, m.groups())) for m in re.finditer(
+        rf"walls \{{ annular_disk \{{ origin: {vec} axis: \[0, 0, 1\] thickness: {num} inner_radius: {num} outer_radius: {num}", text)]
+    boxes = [tuple(map(float, m.groups())) for m in re.finditer(
+        rf"walls \{{ solid_box \{{ lower: {vec} upper: {vec}", text)]
+    return rings, boxes
+
+
+class StentRing(unittest.TestCase):
+    """The 3D fluid stent ring ends at the annulus plane and a scalloped skirt seals under the
+    attachment line (issue 7): the open leaflets have blood behind them, none bypasses them."""
+
+    def check(self, sector):
+        import numpy as np
+        from valve_scene.tube import TubeSetup, skirt_top_height
+        from valve_scene.tube_case import fluid_block
+        from valve_scene.valve_geometry import SECTOR_HALF_ANGLE, ValveParameters
+        dp = 0.9e-3
+        valve, setup = ValveParameters(), TubeSetup()
+        R, R_tube = valve.annulus_radius, 0.5 * setup.tube_diameter
+        rings, boxes = _walls(fluid_block(dp, cycles=2, sector=sector))
+        self.assertEqual(len(rings), 1)
+        _, _, z0, thickness, inner, outer = rings[0]
+        self.assertAlmostEqual(z0, setup.gasket_z - setup.gasket_thickness, delta=1e-12)
+        self.assertAlmostEqual(z0 + thickness, 0.0, delta=1e-9)          # ends at the annulus plane
+        self.assertAlmostEqual(inner, R, delta=1e-12)
+        self.assertAlmostEqual(outer, R_tube, delta=1e-9)                # seals the tube upstream
+        boxes = np.array(boxes)
+        # the fluid's lattice (lattice_origin x, y = 0) near the stent, z from the ring to above the tabs
+        grid = (np.arange(-16, 16) + 0.5) * dp
+        x, y = np.meshgrid(grid, grid, indexing="ij")
+        r, azimuth = np.hypot(x, y), np.arctan2(y, x)
+        z_levels = z0 + (np.arange(0, int((14e-3 - z0) / dp)) + 0.5) * dp
+        wedge = (azimuth >= 0) & (azimuth <= SECTOR_HALF_ANGLE) if sector else np.ones_like(r, bool)
+        top_at = skirt_top_height(azimuth)
+        for z in z_levels:
+            solid = np.zeros_like(r, bool)
+            for b in boxes:
+                solid |= (x > b[0]) & (x < b[3]) & (y > b[1]) & (y < b[4]) & (z > b[2]) & (z < b[5])
+            solid |= (z > z0) & (z < 0) & (r >= R) & (r <= R_tube)
+            # sealed: every lattice point of the skirt wall (R <= r < R + 3 dp) under the attachment line
+            under = wedge & (r >= R) & (r < R + 3 * dp) & (z < top_at)
+            self.assertTrue(np.all(solid[under]), f"skirt gap at z = {z}")
+            # blood behind the leaflets: outside the skirt and above the annulus plane nothing is solid,
+            # and inside the stent never
+            self.assertFalse(np.any(solid[wedge & (r < R)]), f"skirt inside the stent at z = {z}")
+            if z > 0:
+                self.assertFalse(np.any(solid[wedge & (r >= R + 3 * dp) & (r < R_tube)]), f"ring above the annulus at z = {z}")
+            if z > valve.commissure_height + dp:
+                self.assertFalse(np.any(solid[wedge & (r < R_tube)]), f"skirt above the commissures at z = {z}")
+        # the scallop: at the leaflet's centre the skirt stops within a particle of the annulus plane,
+        # at the commissures it reaches the tab tops
+        centre = boxes[np.argmin(np.abs(np.arctan2(boxes[:, 1] + boxes[:, 4], boxes[:, 0] + boxes[:, 3])))]
+        self.assertLess(centre[5], dp)
+        self.assertAlmostEqual(boxes[:, 5].max(), valve.commissure_height, delta=1e-12)
+
+    def test_full_valve(self):
+        self.check(sector=False)
+
+    def test_sector(self):
+        self.check(sector=True)

@@ -12,6 +12,7 @@
 #include "valvefsi/coupler/coupler_run.hpp"
 #include "valvefsi/coupler/launch_plan.hpp"
 #include "valvefsi/coupler/restart_points.hpp"
+#include "valvefsi/coupling/restart_points.hpp"
 #include "valvefsi/coupling/transport_errors.hpp"
 
 int main(int argc, char** argv) {
@@ -58,7 +59,7 @@ int main(int argc, char** argv) {
     if (startup_timeout > 0.0) settings.liveness.startup_timeout = std::chrono::duration<double>(startup_timeout);
     valvefsi::coupling::check_liveness_settings(settings.liveness);
     if (!restart.empty()) {
-      settings.restart_from = std::filesystem::absolute(valvefsi::coupler::resolve_restart_folder(restart));
+      settings.restart_from = std::filesystem::absolute(valvefsi::coupling::resolve_restart_folder(restart, {"coupler", "fluid", "solid"}));
       settings.restart_time = valvefsi::coupler::restart_folder_time(settings.restart_from);
       if (settings.restart_time >= settings.end_time) {
         spdlog::error("coupler: --restart {}: the restart point t = {} s is not before run.end_time = {} s", restart,

@@ -7,6 +7,7 @@
 
 #include "valvefsi/coupler/restart_points.hpp"
 #include "valvefsi/coupling/acceleration.hpp"
+#include "valvefsi/coupling/restart_points.hpp"
 
 namespace valvefsi::coupler {
 
@@ -156,7 +157,7 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
     window.index = summary.windows;
     std::filesystem::path restart;
     if (settings.restart_interval > 0.0 && time >= next_restart * (1.0 - 1e-12)) {
-      restart = restart_folder(settings.output_dir, time);
+      restart = coupling::restart_folder(settings.output_dir, time);
       CouplerRestartState state{time, summary.windows, summary.total_iterations, summary.unconverged_windows,
                                 solid.positions, solid.velocities, previous_node_forces, proposals.fluid,
                                 proposals.solid, acceleration ? acceleration->carried_state() : coupling::CarriedState{}};
@@ -176,7 +177,7 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
     }
     // Both participants answered this window, so both wrote their restart files before it.
     if (!restart.empty()) {
-      mark_restart_complete(restart, settings.restart_keep);
+      coupling::mark_restart_complete(restart, settings.restart_keep);
       spdlog::info("coupler: restart data at t = {} s in {}", window.time, restart.string());
     }
     observe(record);

@@ -2,8 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -11,18 +9,6 @@
 #include "valvefsi/coupling/restart_file.hpp"
 
 namespace valvefsi::coupler {
-
-namespace {
-
-constexpr const char* kComplete = "COMPLETE";
-constexpr const char* kLatest = "LATEST";
-constexpr const char* kFolderPrefix = "t_";
-
-}  // namespace
-
-std::filesystem::path restart_folder(const std::filesystem::path& output_dir, double time) {
-  return output_dir / "restart" / fmt::format("{}{:.9f}", kFolderPrefix, time);
-}
 
 void write_coupler_restart(const std::filesystem::path& folder, const CouplerRestartState& state) {
   coupling::RestartWriter file(coupling::restart_file_path(folder, "coupler"));
@@ -69,58 +55,8 @@ CouplerRestartState read_coupler_restart(const std::filesystem::path& folder,
   return state;
 }
 
-std::filesystem::path resolve_restart_folder(const std::filesystem::path& given) {
-  if (!std::filesystem::is_directory(given))
-    throw std::runtime_error(fmt::format("--restart {}: no such folder", given.string()));
-  std::filesystem::path folder = given;
-  if (!std::filesystem::exists(given / kComplete)) {
-    std::ifstream latest(given / kLatest);
-    std::string name;
-    if (!(latest >> name)) {
-      throw std::runtime_error(
-          fmt::format("--restart {}: neither a complete restart folder (no {} mark) nor a run's "
-                      "restart/ folder (no {} file)",
-                      given.string(), kComplete, kLatest));
-    }
-    folder = given / name;
-    if (!std::filesystem::exists(folder / kComplete))
-      throw std::runtime_error(fmt::format("--restart {}: {} names {}, which is not complete",
-                                           given.string(), kLatest, folder.string()));
-  }
-  for (const char* who : {"coupler", "fluid", "solid"}) {
-    if (!std::filesystem::exists(coupling::restart_file_path(folder, who)))
-      throw std::runtime_error(fmt::format("--restart {}: {} is missing", given.string(),
-                                           coupling::restart_file_path(folder, who).string()));
-  }
-  return folder;
-}
-
 double restart_folder_time(const std::filesystem::path& folder) {
   return coupling::RestartReader(coupling::restart_file_path(folder, "coupler")).scalar("time");
-}
-
-void mark_restart_complete(const std::filesystem::path& folder, int keep) {
-  std::ofstream(folder / kComplete) << "complete\n";
-  const auto parent = folder.parent_path();
-  {
-    const auto temporary = parent / (std::string(kLatest) + ".partial");
-    std::ofstream(temporary) << folder.filename().string() << '\n';
-    std::filesystem::rename(temporary, parent / kLatest);
-  }
-  // Folder names sort by time (fixed decimals, same width while t < 10 s; compare as numbers).
-  std::vector<std::pair<double, std::filesystem::path>> complete;
-  for (const auto& entry : std::filesystem::directory_iterator(parent)) {
-    const auto name = entry.path().filename().string();
-    if (!entry.is_directory() || name.rfind(kFolderPrefix, 0) != 0) continue;
-    if (!std::filesystem::exists(entry.path() / kComplete)) continue;
-    complete.emplace_back(std::stod(name.substr(2)), entry.path());
-  }
-  std::sort(complete.begin(), complete.end(),
-            [](const auto& a, const auto& b) { return a.first > b.first; });
-  for (std::size_t k = static_cast<std::size_t>(std::max(keep, 1)); k < complete.size(); ++k) {
-    std::error_code ignored;
-    std::filesystem::remove_all(complete[k].second, ignored);
-  }
 }
 
 }  // namespace valvefsi::coupler

@@ -1,5 +1,6 @@
 #pragma once
-// Restart points of a coupled run (docs/coupling.md, "Restarts"). At the start of the first
+// The coupler's restart state (docs/coupling.md, "Restarts"); the folder layout is in
+// valvefsi/coupling/restart_points.hpp. At the start of the first
 // window at or after each multiple of coupling.restart_interval_s the coupler writes its own
 // state into output/restart/t_<time>/coupler.restart.h5 and asks both participants to write
 // theirs beside it; once that window is completed by both, the folder gets a COMPLETE mark,
@@ -27,17 +28,11 @@ struct CouplerRestartState {
   coupling::CarriedState acceleration;
 };
 
-std::filesystem::path restart_folder(const std::filesystem::path& output_dir, double time);
 void write_coupler_restart(const std::filesystem::path& folder, const CouplerRestartState& state);
 // Throws std::runtime_error naming the file and entry, or when the solid's node count differs.
 CouplerRestartState read_coupler_restart(const std::filesystem::path& folder,
                                          Eigen::Index solid_nodes);
-// The folder behind what a user gives: a restart folder (with a COMPLETE mark) or the
-// restart/ folder of a run (its LATEST). Throws std::runtime_error saying what is missing.
-std::filesystem::path resolve_restart_folder(const std::filesystem::path& given);
 // The coupler's state time in a restart folder.
 double restart_folder_time(const std::filesystem::path& folder);
-// Marks `folder` complete, points LATEST at it, removes older folders beyond `keep`.
-void mark_restart_complete(const std::filesystem::path& folder, int keep);
 
 }  // namespace valvefsi::coupler

@@ -257,3 +257,38 @@ def peak_with_location(values, reference_nodes, elements, node_sets, near: float
     else:
         region = "belly"
     return FieldPeak(float(values[e]), e, centroid, region)
+
+
+ROBUST_PEAK_FRACTION = 0.01   # the robust peak is the value exceeded on 1 % of the leaflet area
+
+
+def triangle_areas(reference_nodes, triangles) -> np.ndarray:
+    """Areas of the triangles on the reference (undeformed) mesh (m^2)."""
+    p = np.asarray(reference_nodes, dtype=float)[np.asarray(triangles)]
+    return 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+
+
+def area_percentile(values, areas, fraction: float = ROBUST_PEAK_FRACTION) -> float:
+    """The value the field reaches on the top `fraction` of the leaflet's reference area:
+    elements sorted by value (largest first), element k covering the area fraction
+    (A_(k-1), A_k], the value of the element whose interval holds `fraction`. Unlike the
+    maximum, one element (a mesh corner, a flutter spike) cannot move it unless it carries more
+    than `fraction` of the area, and splitting elements does not change it."""
+    values = np.asarray(values, dtype=float)
+    areas = np.asarray(areas, dtype=float)
+    if values.shape != areas.shape or values.size == 0:
+        raise ValueError(f"area_percentile: {values.size} values for {areas.size} areas (need equal, > 0)")
+    order = np.argsort(values, kind="stable")[::-1]
+    covered = np.cumsum(areas[order]) / areas.sum()   # A_k
+    k = int(np.searchsorted(covered, min(max(fraction, 0.0), 1.0) * (1 - 1e-12)))
+    return float(values[order][min(k, values.size - 1)])
+
+
+def robust_peak(snapshots, areas, fraction: float = ROBUST_PEAK_FRACTION) -> tuple[float, int]:
+    """The largest over snapshots of area_percentile (the value exceeded on `fraction` of the
+    leaflet area at that instant); returns (value, snapshot index)."""
+    per_snapshot = [area_percentile(values, areas, fraction) for values in snapshots]
+    if not per_snapshot:
+        raise ValueError("robust_peak: no snapshots")
+    k = int(np.argmax(per_snapshot))
+    return per_snapshot[k], k

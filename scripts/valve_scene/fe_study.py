@@ -10,6 +10,7 @@ Writes runs/<case>/ (solver output), docs/fe-only-study.md and docs/figures/fe-o
 from __future__ import annotations
 
 import argparse
+import re
 import subprocess
 import sys
 import time
@@ -18,13 +19,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .analysis import (ValveEvents, bisection_profile, geometric_orifice_area, peak_with_location,
-                       valve_events)
+from .analysis import (ROBUST_PEAK_FRACTION, ValveEvents, bisection_profile, geometric_orifice_area,
+                       peak_with_location, robust_peak, triangle_areas, valve_events)
 from .valve_mesh import build_valve_mesh
 from .report import REFERENCE_KINEMATICS_MS, REFERENCE_PEAKS, plot_kinematics, plot_profiles
 from .solid_results import SolidFields, read_series
 from .waveform import PERIOD_S
-from .write_cases import CASES_DIR, CaseSpec, write_cases, write_meshes
+from .write_cases import CASES_DIR, CaseSpec, case_text, write_cases, write_meshes
 
 REPO = Path(__file__).resolve().parents[2]
 OPENING_WINDOW_S = 0.05           # opening peaks are searched over the first 50 ms of the cycle
@@ -39,9 +40,14 @@ class ModelResult:
     events: ValveEvents | None
     events_error: str = ""
     series: dict = field(default_factory=dict)
-    peaks: dict = field(default_factory=dict)      # name -> FieldPeak
+    peaks: dict = field(default_factory=dict)      # name -> (FieldPeak, time in cycle)
+    robust_peaks: dict = field(default_factory=dict)   # name -> (area percentile value, time in cycle)
     profiles: dict = field(default_factory=dict)   # time in cycle -> polyline
     energy_error_max: float = float("nan")
+    label: str = ""
+
+    def __post_init__(self):
+        self.label = self.label or self.spec.name
 
 
 def run_case(spec: CaseSpec, build_dir: Path, log_dir: Path, runs_dir: Path = REPO / "runs") -> float:
@@ -57,6 +63,120 @@ def run_case(spec: CaseSpec, build_dir: Path, log_dir: Path, runs_dir: Path = RE
     if result.returncode != 0:
         raise RuntimeError(f"{spec.name}: run_case.py exited with {result.returncode}; see {log_dir / (spec.name + '.log')}")
     return wall
+
+
+# The cheap faithful study (--windows): the FE-only valve follows the pressure with no flow to
+# remember, so the opening and the closing can be run as two short windows from the stress-free
+# closed leaflet. The closing window starts while the valve is open and settles (open in ~3 ms,
+# flutter damped) before the analysed part begins.
+OPENING_WINDOW = (0.0, 0.06)
+CLOSING_WINDOW = (0.15, 0.32)
+CLOSING_SETTLE_S = 0.03
+WINDOW_RAMP_S = 0.005   # the closing window's gradient (~2.8 mmHg) ramps up instead of stepping
+
+
+def window_case_text(spec: CaseSpec, start_s: float, end_s: float) -> str:
+    """The case of `spec` run from cycle time start_s to end_s: the waveform table rotated so the
+    run's t = 0 is cycle time start_s, the mesh path absolute (the file lives in the runs folder)."""
+    from . import waveform
+    text = case_text(spec)
+    t, p_lv, p_ao = waveform.sampled_table()
+    shifted_lv = np.interp((t + start_s) % waveform.PERIOD_S, t, p_lv, period=waveform.PERIOD_S)
+    shifted_ao = np.interp((t + start_s) % waveform.PERIOD_S, t, p_ao, period=waveform.PERIOD_S)
+    fmt = waveform._format_list
+    block = ("waveform {\n"
+             f"  # rotated: t = 0 here is cycle time {start_s:g} s\n"
+             f"  period_s: {waveform.PERIOD_S:g}\n"
+             f"  time_s: {fmt(t, '{:.3f}')}\n"
+             f"  ventricular_pressure_mmHg: {fmt(shifted_lv, '{:.3f}')}\n"
+             f"  aortic_pressure_mmHg: {fmt(shifted_ao, '{:.3f}')}\n"
+             + (f"  ramp_time: {WINDOW_RAMP_S:g}\n" if start_s > 0 else "") +
+             "}\n")
+    text = text.replace(waveform.waveform_textproto(), block)
+    text = re.sub(r"end_time: [0-9.]+", f"end_time: {end_s - start_s:.6g}", text, count=1)
+    return text.replace(f'mesh_file: "meshes/{spec.mesh_name}"', f'mesh_file: "{CASES_DIR / "meshes" / spec.mesh_name}"')
+
+
+def run_window(spec: CaseSpec, window: tuple[float, float], build_dir: Path, runs_dir: Path) -> tuple[Path, float]:
+    """Runs one window of an FE-only case; returns (run folder, wall time)."""
+    name = f"{spec.name}-window-{window[0] * 1e3:.0f}-{window[1] * 1e3:.0f}ms"
+    runs_dir.mkdir(parents=True, exist_ok=True)
+    case_file = runs_dir / f"{name}.textproto"
+    case_file.write_text(window_case_text(spec, *window))
+    out = runs_dir / name
+    cmd = [sys.executable, str(REPO / "scripts" / "run_case.py"), str(case_file), "--output", str(out), "--fe-only",
+           "--build-dir", str(build_dir)]
+    start = time.monotonic()
+    with open(runs_dir / f"{name}.log", "w") as log:
+        result = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, cwd=REPO)
+    if result.returncode != 0:
+        raise RuntimeError(f"{name}: run_case.py exited with {result.returncode}; see {runs_dir / (name + '.log')}")
+    return out, time.monotonic() - start
+
+
+def analyse_windows(spec: CaseSpec, opening_dir: Path, closing_dir: Path, wall_time_s: float | None = None) -> ModelResult:
+    """RVOT, RVCT, ET and the peaks from the two windows: the free-edge curve of the opening window
+    (cycle time 0-60 ms) joined to the closing window's after it settled (from 180 ms), the
+    opening peaks from the first, the closed ones (300 ms) from the second."""
+    mesh = build_valve_mesh(spec.variant, spec.resolution, "triangles")
+    R = float(mesh.description["param_annulus_radius"])
+    result = ModelResult(spec, wall_time_s, None)
+    parts, errors = [], []
+    for run_dir, offset, keep_from in ((opening_dir, OPENING_WINDOW[0], OPENING_WINDOW[0]),
+                                       (closing_dir, CLOSING_WINDOW[0], CLOSING_WINDOW[0] + CLOSING_SETTLE_S)):
+        series = read_series(run_dir)
+        t = series.time + offset
+        keep = t >= keep_from - 1e-12
+        radial = np.hypot(series.midpoint_positions[keep, :, 0], series.midpoint_positions[keep, :, 1]).mean(axis=1)
+        parts.append((t[keep], radial))
+        errors.append(float(np.nanmax(np.abs(series.energy_balance_error))))
+    t = np.concatenate([p[0] for p in parts])
+    radial = np.concatenate([p[1] for p in parts])
+    result.energy_error_max = max(errors)
+    try:
+        result.events = valve_events(t, radial)
+    except ValueError as error:
+        result.events_error = str(error)
+    goa, goa_t = [], []
+    for run_dir, offset, keep_from in ((opening_dir, OPENING_WINDOW[0], 0.0),
+                                       (closing_dir, CLOSING_WINDOW[0], CLOSING_WINDOW[0] + CLOSING_SETTLE_S)):
+        fields = SolidFields(run_dir)
+        for k in np.flatnonzero(fields.times + offset >= keep_from - 1e-12):
+            goa.append(geometric_orifice_area(fields.snapshot(int(k))["position"], fields.triangles, R,
+                                              (0.0, 60.0) if spec.variant == "sector" else None, pixels_across=600))
+            goa_t.append(fields.times[k] + offset)
+    result.series = {"time_s": t, "free_edge_radial_position_m": radial, "goa_time_s": np.array(goa_t), "goa_m2": np.array(goa)}
+    leaflet0 = mesh.triangles[mesh.element_sets["leaflet_0_triangles"][1]]
+    for window, run_dir, names in ((OPENING_WINDOW, opening_dir, ("opening",)), (CLOSING_WINDOW, closing_dir, ("closed",))):
+        fields = SolidFields(run_dir)
+        areas = triangle_areas(fields.reference_nodes, fields.triangles)
+        for tp in PROFILE_TIMES_S:
+            if window[0] + (CLOSING_SETTLE_S if window[0] > 0 else 0) <= tp <= window[1]:
+                k = fields.nearest(tp - window[0])
+                result.profiles[round(fields.times[k] + window[0], 6)] = bisection_profile(fields.snapshot(k)["position"], leaflet0, 0.0)
+        indices = (np.flatnonzero(fields.times <= OPENING_WINDOW_S + 1e-12) if window[0] == 0
+                   else [fields.nearest(CLOSED_TIME_S - window[0])])
+        _window_peaks(result, names[0], fields, indices, window[0], areas, mesh)
+    return result
+
+
+def _window_peaks(result: ModelResult, name: str, fields: SolidFields, indices, t0: float, areas, mesh) -> None:
+    """Element maximum (with its region) and robust peak of strain and stress over the snapshots
+    `indices`, stored under `name`; a snapshot's cycle time is its run time + `t0`."""
+    best, history = {}, {}
+    for k in indices:
+        snapshot = fields.snapshot(int(k))
+        for quantity in ("max_principal_log_strain", "max_principal_stress"):
+            if quantity not in snapshot:
+                continue
+            history.setdefault(quantity, []).append(snapshot[quantity])
+            peak = peak_with_location(snapshot[quantity], fields.reference_nodes, fields.triangles, mesh.node_sets)
+            if quantity not in best or peak.value > best[quantity][0].value:
+                best[quantity] = (peak, fields.times[k] + t0)
+    for quantity, (peak, when) in best.items():
+        result.peaks[f"{name}/{quantity}"] = (peak, when)
+        value, j = robust_peak(history[quantity], areas)
+        result.robust_peaks[f"{name}/{quantity}"] = (value, fields.times[indices[j]] + t0)
 
 
 def analyse(spec: CaseSpec, run_dir: Path, cycle: int = 2, wall_time_s: float | None = None) -> ModelResult:
@@ -94,18 +214,9 @@ def analyse(spec: CaseSpec, run_dir: Path, cycle: int = 2, wall_time_s: float | 
         result.profiles[round(fields.times[k] - t0, 6)] = bisection_profile(fields.snapshot(k)["position"], leaflet0, 0.0)
 
     opening = snap[(fields.times[snap] - t0) <= OPENING_WINDOW_S]
-    for name, indices in (("opening", opening), ("closed", [fields.nearest(t0 + CLOSED_TIME_S)])):
-        best = {}
-        for k in indices:
-            snapshot = fields.snapshot(int(k))
-            for quantity in ("max_principal_log_strain", "max_principal_stress"):
-                if quantity not in snapshot:
-                    continue
-                peak = peak_with_location(snapshot[quantity], fields.reference_nodes, fields.triangles, mesh.node_sets)
-                if quantity not in best or peak.value > best[quantity][0].value:
-                    best[quantity] = (peak, fields.times[k] - t0)
-        for quantity, (peak, when) in best.items():
-            result.peaks[f"{name}/{quantity}"] = (peak, when)
+    areas = triangle_areas(fields.reference_nodes, fields.triangles)
+    _window_peaks(result, "opening", fields, opening, -t0, areas, mesh)
+    _window_peaks(result, "closed", fields, [fields.nearest(t0 + CLOSED_TIME_S)], -t0, areas, mesh)
     return result
 
 
@@ -116,59 +227,68 @@ def _ms(value) -> str:
 def opening_table(opening: dict) -> list[str]:
     """Markdown rows: name -> opening_metrics(...) (or an error string)."""
     lines = ["## Opening: resolution and sector against full (first 60 ms)", "",
-             "| run | opening start (ms) | RVOT 10-90 % (ms) | open free-edge r (mm) | peak log strain | peak stress (MPa) |",
-             "|---|---|---|---|---|---|"]
+             "| run | opening start (ms) | RVOT 10-90 % (ms) | open free-edge r (mm) | log strain p99 | peak log strain | peak stress (MPa) |",
+             "|---|---|---|---|---|---|---|"]
     for name, m in opening.items():
         if isinstance(m, str):
-            lines.append(f"| {name} | {m} | | | | |")
+            lines.append(f"| {name} | {m} | | | | | |")
             continue
         lines.append(f"| {name} | {m['opening_start_s'] * 1e3:.2f} | {m['rvot_s'] * 1e3:.2f} | {m['r_open_m'] * 1e3:.2f} | "
-                     f"{m['peak_log_strain']:.3f} | {m['peak_stress_Pa'] * 1e-6:.2f} |")
-    lines += ["| reference FE-MHGO | – | 6 | – | ≈ 0.22 (5 ms) | – |", ""]
+                     f"{m.get('robust_log_strain', float('nan')):.3f} | {m['peak_log_strain']:.3f} | {m['peak_stress_Pa'] * 1e-6:.2f} |")
+    lines += ["| reference FE-MHGO | – | 6 | – | – | ≈ 0.22 (5 ms) | – |", ""]
     return lines
 
 
 def write_report(results: list[ModelResult], path: Path, figures_dir: Path, cycle: int = 2,
-                 opening: dict | None = None, notes: str = "") -> None:
+                 opening: dict | None = None, notes: str = "", mode: str = "cycles") -> None:
     figures_dir.mkdir(parents=True, exist_ok=True)
+    how = (f"rows \"(windows)\": the opening ({OPENING_WINDOW[0] * 1e3:.0f}–{OPENING_WINDOW[1] * 1e3:.0f} ms) and closing "
+           f"({CLOSING_WINDOW[0] * 1e3:.0f}–{CLOSING_WINDOW[1] * 1e3:.0f} ms, analysed from "
+           f"{(CLOSING_WINDOW[0] + CLOSING_SETTLE_S) * 1e3:.0f} ms) windows, each started from the stress-free leaflet; "
+           f"rows \"(cycle {cycle})\": cycle {cycle} of a two-cycle run" if mode == "windows" else f"cycle {cycle} is analysed")
     lines = ["# FE-only study: the reference's FE columns", "",
-             f"Generated by `cd scripts && /usr/bin/python3 -m valve_scene.fe_study`; cycle {cycle} "
-             "is analysed. Definitions: docs/valve-scene.md (\"Analysis\").", "",
+             f"Generated by `cd scripts && /usr/bin/python3 -m valve_scene.fe_study` (--mode {mode}); {how}. "
+             "Definitions: docs/valve-scene.md (\"Analysis\").", "",
              "## Kinematics (reference Table 3, FE-only columns)", "",
              "| case | RVOT (ms) | RVCT (ms) | ET (ms) | opening start (ms) | closing end (ms) | wall time (s) | max energy-balance error |",
              "|---|---|---|---|---|---|---|---|"]
     for r in results:
         e = r.events
-        lines.append(f"| {r.spec.name} | {_ms(e and e.rvot)} | {_ms(e and e.rvct)} | {_ms(e and e.et)} | "
+        lines.append(f"| {r.label} | {_ms(e and e.rvot)} | {_ms(e and e.rvct)} | {_ms(e and e.et)} | "
                      f"{_ms(e and e.opening_start)} | {_ms(e and e.closing_end)} | "
                      f"{'–' if r.wall_time_s is None else f'{r.wall_time_s:.0f}'} | {r.energy_error_max:.2g} |"
                      + (f" {r.events_error}" if r.events_error else ""))
     for model in ("FE-Ogden", "FE-MHGO"):
         ref = REFERENCE_KINEMATICS_MS[model]
         lines.append(f"| reference {model} | {ref['RVOT']} | {ref['RVCT']} | {ref['ET']} | | | | |")
+    percent = f"{100 * (1 - ROBUST_PEAK_FRACTION):g}"
     lines += ["", "## Peak max-principal log strain and stress (reference Sec. 3.2)", "",
-              "| case | when | log strain | at (ms) | where | stress (MPa) | at (ms) | where |", "|---|---|---|---|---|---|---|---|"]
+              f"Robust peak (p{percent}): the value exceeded on {100 * ROBUST_PEAK_FRACTION:g} % of the leaflet's reference area, "
+              "largest over the window's snapshots (definition: docs/valve-scene.md); the element maximum beside it.", "",
+              f"| case | when | log strain p{percent} | max | at (ms) | where | stress p{percent} (MPa) | max (MPa) | at (ms) | where |",
+              "|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         for when in ("opening", "closed"):
-            strain = r.peaks.get(f"{when}/max_principal_log_strain")
-            stress = r.peaks.get(f"{when}/max_principal_stress")
             cells = []
-            for item, scale, digits in ((strain, 1.0, 3), (stress, 1e-6, 2)):
+            for quantity, scale, digits in (("max_principal_log_strain", 1.0, 3), ("max_principal_stress", 1e-6, 2)):
+                item = r.peaks.get(f"{when}/{quantity}")
+                robust = r.robust_peaks.get(f"{when}/{quantity}")
                 if item is None:
-                    cells += ["–", "–", "–"]
+                    cells += ["–", "–", "–", "–"]
                 else:
                     peak, at = item
-                    cells += [f"{peak.value * scale:.{digits}f}", f"{at * 1e3:.0f}", peak.region]
-            lines.append(f"| {r.spec.name} | {when} | " + " | ".join(cells) + " |")
+                    cells += [f"{robust[0] * scale:.{digits}f}" if robust else "–", f"{peak.value * scale:.{digits}f}",
+                              f"{at * 1e3:.0f}", peak.region]
+            lines.append(f"| {r.label} | {when} | " + " | ".join(cells) + " |")
     ref = REFERENCE_PEAKS["FE-MHGO"]
-    lines += [f"| reference FE-MHGO | opening | {ref['strain_opening']} | 5 | below the commissures, along the attachment | | | |",
-              f"| reference MHGO | closed | {ref['strain_closed']} | | attachment hinge | 1.13 (FSI-MHGO) | 300 | commissure |", ""]
+    lines += [f"| reference FE-MHGO | opening | | {ref['strain_opening']} | 5 | below the commissures, along the attachment | | | | |",
+              f"| reference MHGO | closed | | {ref['strain_closed']} | | attachment hinge | | 1.13 (FSI-MHGO) | 300 | commissure |", ""]
     by_material = {}
     for r in results:
         by_material.setdefault((r.spec.material, r.spec.variant), []).append(r)
     for (material, variant), group in by_material.items():
         name = f"fe-{material.lower()}-{variant}"
-        series = {f"{r.spec.resolution}": {"time_s": r.series["time_s"], "free_edge_radial_position_m": r.series["free_edge_radial_position_m"],
+        series = {(f"{r.spec.resolution}" if len(group) == 1 or r.label == r.spec.name else r.label.split(" (")[1].rstrip(")")): {"time_s": r.series["time_s"], "free_edge_radial_position_m": r.series["free_edge_radial_position_m"],
                                             "goa_m2": np.interp(r.series["time_s"], r.series["goa_time_s"], r.series["goa_m2"])
                                             if len(r.series.get("goa_m2", [])) else np.zeros_like(r.series["time_s"])}
                   for r in group}
@@ -187,13 +307,18 @@ def write_report(results: list[ModelResult], path: Path, figures_dir: Path, cycl
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--mode", choices=("windows", "cycles"), default="windows",
+                        help="windows (default, minutes): the opening (0-60 ms) and closing (150-320 ms) windows of "
+                             "each model; cycles: two whole cycles, the second analysed (~25 min CPU per model, coarse)")
     parser.add_argument("--variant", choices=("full", "sector"), default="sector")
-    parser.add_argument("--resolutions", nargs="+", default=["coarse", "medium"])
+    parser.add_argument("--resolutions", nargs="+", default=["coarse"])
     parser.add_argument("--materials", nargs="+", default=["Ogden", "MHGO"])
     parser.add_argument("--build-dir", type=Path, default=REPO / "build")
     parser.add_argument("--skip-run", action="store_true", help="analyse existing runs/ folders only")
     parser.add_argument("--report", type=Path, default=REPO / "docs" / "fe-only-study.md")
     parser.add_argument("--cycle", type=int, default=2, help="cycle analysed (1 when the runs stopped in the second)")
+    parser.add_argument("--cycle-runs-dir", type=Path,
+                        help="windows mode: also analyse the two-cycle runs in this folder (rows next to the windows')")
     parser.add_argument("--opening-runs", nargs="*", type=Path, default=[],
                         help="run folders whose first 60 ms give the opening table (other resolutions, the full valve)")
     parser.add_argument("--notes", type=Path, help="Markdown appended to the report (the discussion)")
@@ -202,25 +327,42 @@ def main(argv=None) -> None:
     write_cases(CASES_DIR)
     if not all((CASES_DIR / "meshes" / f"valve-{args.variant}-{r}.mesh.h5").exists() for r in args.resolutions):
         write_meshes(CASES_DIR)
-    results = []
+    results, opening_dirs = [], []
     for material in args.materials:
         for resolution in args.resolutions:
             spec = CaseSpec("FE", material, args.variant, resolution)
-            wall = None if args.skip_run else run_case(spec, args.build_dir, args.runs_dir / "logs", args.runs_dir)
-            results.append(analyse(spec, args.runs_dir / spec.name, cycle=args.cycle, wall_time_s=wall))
+            if args.mode == "windows":
+                dirs, walls = [], []
+                for window in (OPENING_WINDOW, CLOSING_WINDOW):
+                    name = f"{spec.name}-window-{window[0] * 1e3:.0f}-{window[1] * 1e3:.0f}ms"
+                    if args.skip_run:
+                        dirs.append(args.runs_dir / name)
+                    else:
+                        run_dir, wall = run_window(spec, window, args.build_dir, args.runs_dir)
+                        dirs.append(run_dir)
+                        walls.append(wall)
+                results.append(analyse_windows(spec, *dirs, wall_time_s=sum(walls) if walls else None))
+                results[-1].label = f"{spec.name} (windows)"
+                opening_dirs.append(dirs[0])
+                if args.cycle_runs_dir and (args.cycle_runs_dir / spec.name).exists():
+                    results.append(analyse(spec, args.cycle_runs_dir / spec.name, cycle=args.cycle))
+                    results[-1].label = f"{spec.name} (cycle {args.cycle})"
+            else:
+                wall = None if args.skip_run else run_case(spec, args.build_dir, args.runs_dir / "logs", args.runs_dir)
+                results.append(analyse(spec, args.runs_dir / spec.name, cycle=args.cycle, wall_time_s=wall))
+                opening_dirs.append(args.runs_dir / spec.name)
             e = results[-1].events
-            print(f"{spec.name}: wall {wall} s, " + (f"RVOT {e.rvot * 1e3:.1f} ms, RVCT {e.rvct * 1e3:.1f} ms, ET {e.et * 1e3:.1f} ms"
-                                                      if e else results[-1].events_error))
+            print(f"{results[-1].label}: wall {results[-1].wall_time_s} s, "
+                  + (f"RVOT {e.rvot * 1e3:.1f} ms, RVCT {e.rvct * 1e3:.1f} ms, ET {e.et * 1e3:.1f} ms" if e else results[-1].events_error))
     opening = {}
-    for run_dir in [args.runs_dir / r.spec.name for r in results] + list(args.opening_runs):
+    for run_dir in opening_dirs + list(args.opening_runs):
         try:
             opening[run_dir.name] = opening_metrics(run_dir)
         except (FileNotFoundError, KeyError, ValueError, IndexError) as error:
             opening[run_dir.name] = f"not measured: {error}"
     notes = args.notes.read_text() if args.notes else ""
-    write_report(results, args.report, args.report.parent / "figures", args.cycle, opening, notes)
+    write_report(results, args.report, args.report.parent / "figures", args.cycle, opening, notes, args.mode)
     print(args.report)
-
 
 
 def opening_metrics(run_dir: Path, end_s: float = 0.06, plateau_from_s: float = 0.03) -> dict:
@@ -247,8 +389,16 @@ def opening_metrics(run_dir: Path, end_s: float = 0.06, plateau_from_s: float = 
         sel = ts <= end_s + 1e-12
         strain = float(f["snapshots/peak_max_principal_log_strain"][()][sel].max())
         stress = float(f["snapshots/peak_max_principal_stress"][()][sel].max())
+    robust = float("nan")
+    try:
+        fields = SolidFields(run_dir)
+        areas = triangle_areas(fields.reference_nodes, fields.triangles)
+        indices = np.flatnonzero(fields.times <= end_s + 1e-12)
+        robust = robust_peak([fields.snapshot(int(k))["max_principal_log_strain"] for k in indices], areas)[0]
+    except (FileNotFoundError, KeyError, ValueError):
+        pass
     return {"opening_start_s": t10, "opening_end_s": t90, "rvot_s": t90 - t10, "r_open_m": r_open,
-            "peak_log_strain": strain, "peak_stress_Pa": stress}
+            "peak_log_strain": strain, "peak_stress_Pa": stress, "robust_log_strain": robust}
 
 
 if __name__ == "__main__":

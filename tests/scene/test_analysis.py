@@ -197,3 +197,50 @@ class HexahedronRuns(unittest.TestCase):
         # times the tilt of the free-edge region, so the brick GOA is smaller, not larger
         self.assertLess(bricks, shell)
         self.assertGreater(bricks, 0.5 * shell)
+
+
+class RobustPeak(unittest.TestCase):
+    """The robust peak (area percentile, docs/valve-scene.md) on fields with known answers."""
+
+    def test_equal_areas_read_the_ranked_value(self):
+        from valve_scene.analysis import area_percentile
+        values = np.arange(1.0, 101.0)          # 100 equal elements: the top 5 % are 96..100
+        self.assertAlmostEqual(area_percentile(values, np.ones(100), 0.05), 96.0, delta=1e-12)
+        self.assertAlmostEqual(area_percentile(values, np.ones(100), 0.041), 96.0, delta=1e-12)
+        self.assertAlmostEqual(area_percentile(values, np.ones(100), 0.04), 97.0, delta=1e-12)
+        self.assertAlmostEqual(area_percentile(values, np.ones(100), 0.005), 100.0, delta=1e-12)
+
+    def test_one_hot_element_does_not_move_it(self):
+        from valve_scene.analysis import area_percentile
+        rng = np.random.default_rng(3)
+        values = 0.2 + 0.01 * rng.random(1000)
+        base = area_percentile(values, np.ones(1000))
+        spiked = values.copy()
+        spiked[17] = 5.0                        # a corner singularity or a flutter spike
+        self.assertAlmostEqual(area_percentile(spiked, np.ones(1000)), base, delta=1e-4)
+        self.assertEqual(spiked.max(), 5.0)
+
+    def test_splitting_elements_does_not_change_it(self):
+        from valve_scene.analysis import area_percentile
+        rng = np.random.default_rng(5)
+        values, areas = rng.random(400), 0.5 + rng.random(400)
+        split = area_percentile(np.repeat(values, 2), np.repeat(areas / 2, 2))
+        self.assertAlmostEqual(split, area_percentile(values, areas), delta=1e-12)
+
+    def test_area_weighted(self):
+        from valve_scene.analysis import area_percentile, triangle_areas
+        # one large hot triangle (area 2) among 98 small cold ones (area 1e-2 each)
+        nodes = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0], [0, 0.1, 0], [0.1, 0, 0]], float)
+        areas = np.concatenate([triangle_areas(nodes, [[0, 1, 2]]), np.full(98, 1e-2)])
+        self.assertAlmostEqual(areas[0], 2.0, delta=1e-12)
+        values = np.concatenate([[1.0], np.zeros(98)])
+        self.assertEqual(area_percentile(values, areas, 0.5), 1.0)
+        self.assertEqual(area_percentile(values, np.ones(99), 0.5), 0.0)
+
+    def test_robust_peak_over_snapshots(self):
+        from valve_scene.analysis import robust_peak
+        snapshots = [np.full(200, 0.1), np.full(200, 0.3), np.full(200, 0.2)]
+        snapshots[2][0] = 9.0
+        self.assertEqual(robust_peak(snapshots, np.ones(200)), (0.3, 1))
+        with self.assertRaises(ValueError):
+            robust_peak([], np.ones(3))

@@ -27,10 +27,19 @@ def deform(nodes, fraction):
     return x
 
 
-def write_fake_run(run_dir: Path, spec: CaseSpec):
+def window_fraction(offset):
+    """A window run started at cycle time `offset` from the closed leaflet: closed for its
+    first 10 ms (the start-up the analysis must skip), then as the cycle."""
+    return lambda t: np.where(np.asarray(t) < 0.01, 0.0, opening_fraction(np.asarray(t) + offset)) if offset > 0 \
+        else opening_fraction(t)
+
+
+def write_fake_run(run_dir: Path, spec: CaseSpec, end=1.6, fraction=opening_fraction):
     mesh = build_valve_mesh(spec.variant, spec.resolution, "triangles")
     mid = mesh.node_sets["free_edge_midpoints"]
-    t_series = np.arange(0, 1.6 + 1e-9, 1e-4)
+    opening_fraction = fraction
+    run_dir.mkdir(parents=True, exist_ok=True)
+    t_series = np.arange(0, end + 1e-9, 1e-4)
     positions = np.stack([deform(mesh.nodes[mid], f) for f in opening_fraction(t_series)])
     with h5py.File(run_dir / "solid_series.h5", "w") as f:
         f["time"] = t_series
@@ -45,7 +54,7 @@ def write_fake_run(run_dir: Path, spec: CaseSpec):
     with h5py.File(run_dir / "solid_fields.h5", "w") as f:
         f["mesh/nodes"] = mesh.nodes
         f["mesh/triangles"] = mesh.triangles
-        for k, t in enumerate(np.arange(0, 1.6 + 1e-9, 0.005)):
+        for k, t in enumerate(np.arange(0, end + 1e-9, 0.005)):
             g = f.create_group(f"snapshots/{k:06d}")
             g.attrs["time"] = t
             frac = float(opening_fraction(t))
@@ -106,3 +115,35 @@ class OpeningMetrics(unittest.TestCase):
             self.assertEqual(m["peak_stress_Pa"], 1e6)
             with self.assertRaisesRegex(ValueError, "ends at 0.1 s, before 0.2 s"):
                 opening_metrics(run, end_s=0.2)
+
+
+class FeStudyWindows(unittest.TestCase):
+    def test_windows_give_the_cycle_metrics(self):
+        from valve_scene.fe_study import CLOSING_WINDOW, OPENING_WINDOW, analyse_windows, window_case_text
+        spec = CaseSpec("FE", "MHGO", "sector", "coarse")
+        with tempfile.TemporaryDirectory() as tmp:
+            opening, closing = Path(tmp) / "opening", Path(tmp) / "closing"
+            write_fake_run(opening, spec, OPENING_WINDOW[1], window_fraction(0.0))
+            write_fake_run(closing, spec, CLOSING_WINDOW[1] - CLOSING_WINDOW[0], window_fraction(CLOSING_WINDOW[0]))
+            result = analyse_windows(spec, opening, closing)
+            self.assertIsNotNone(result.events, result.events_error)
+            self.assertAlmostEqual(result.events.rvot, 0.8 * 0.005, delta=1e-6)
+            self.assertAlmostEqual(result.events.rvct, 0.8 * 0.010, delta=1e-6)
+            self.assertAlmostEqual(result.events.et, (0.230 + 0.9 * 0.010) - 0.1 * 0.005, delta=1e-6)
+            self.assertIn("closed/max_principal_log_strain", result.robust_peaks)
+            self.assertAlmostEqual(result.peaks["closed/max_principal_log_strain"][1], 0.30, delta=1e-9)
+        # the window's case: the waveform rotated to start at the window's cycle time
+        import re
+        from valve_scene.waveform import transvalvular_pressure_mmHg
+        text = window_case_text(spec, 0.15, 0.32)
+        self.assertIn("end_time: 0.17", text)
+
+        def table(name):
+            block = re.search(name + r": \[([^\]]*)\]", text).group(1)
+            return np.array([float(v) for v in block.replace("\n", " ").split(",")])
+        t = table("time_s")
+        dp = table("ventricular_pressure_mmHg") - table("aortic_pressure_mmHg")
+        for run_time in (0.0, 0.05, 0.09, 0.15):
+            k = int(round(run_time / 1e-3))
+            self.assertAlmostEqual(t[k], run_time, delta=1e-9)
+            self.assertAlmostEqual(dp[k], float(transvalvular_pressure_mmHg(0.15 + run_time)), delta=2e-3)

@@ -15,7 +15,16 @@ Definitions (reference Sec. 2.4 and 3.3, after ISO 5840; written in docs/hemodyn
 - forward-flow period [t1, t2]: the interval around the cycle's peak flow where the flow,
   smoothed by a centred moving average of `smoothing_s`, is positive (zero crossings
   interpolated linearly);
-- MSPD = mean of dP over [t1, t2]; PSPD = max of dP over [t1, t2] (with its time);
+- each tap is the mean over its cross-section: the centre probe <tap> and, where the case has
+  them, the probes <tap>_section_<k> across the same section (the 2D and 3D cases put four);
+- MSPD = mean of dP over [t1, t2]; PSPD = max over [t1, t2] of dP smoothed by the same centred
+  moving average as Q (with its time): a single probe's dP has acoustic spikes of a particle
+  squeezed or a pressure wave passing (230 mmHg in the 2D xcoarse cycle), not the jet's drop;
+  the raw single-probe maximum is kept as pspd_probe_mmHg;
+- peak velocity = max over the cycle of the jet-core speed, the flow through the core disk
+  (radius JET_CORE_RADIUS_M around the axis; in 2D the segment |y| < it) on the section 15 mm
+  downstream over its area, smoothed as Q; the fastest particle on the plane (a single
+  particle, 27 m/s spikes) is kept as peak_particle_speed;
 - Qrms = sqrt(mean of Q^2 over [t1, t2]); EOA = Qrms / (51.6 sqrt(MSPD)) with Q in mL/s and
   dP in mmHg gives cm^2 (51.6 = sqrt(2 * 1333.2 dyn/cm^2 / 1 g/cm^3): Bernoulli's jet speed
   in cm/s per sqrt(mmHg));
@@ -45,6 +54,9 @@ from . import waveform
 PA_PER_MMHG = 133.322387415
 GORLIN_CONSTANT = 51.6        # cm/s per sqrt(mmHg), with Q in mL/s -> EOA in cm^2
 ANNULUS_RADIUS_M = 11.5e-3    # size 23
+JET_CORE_RADIUS_M = 0.5 * ANNULUS_RADIUS_M   # the jet core: half the annulus radius around the axis
+JET_CORE_PLANE = "jet_core_15mm"              # flow plane of the jet core (radius JET_CORE_RADIUS_M)
+SECTION_SUFFIX = "_section_"                  # <tap>_section_<k>: the tap's cross-section probes
 
 # Reference Table 2 and Sec. 3.3 (W. Mao, K. Li, W. Sun, "Fluid-structure interaction study of
 # transcatheter aortic valve dynamics using smoothed particle hydrodynamics", Cardiovasc. Eng.
@@ -70,6 +82,9 @@ class ProbeSeries:
     flow_rates: dict                        # section name -> m^3/s (m^2/s in 2D)
     max_velocity: np.ndarray | None         # m/s on the velocity plane, or None
     dimension: int = 3
+    jet_core_flow: np.ndarray | None = None  # m^3/s (m^2/s in 2D) through the jet core, or None
+    upstream_centre: np.ndarray | None = None    # the single centre probes (Pa), for the raw PSPD
+    downstream_centre: np.ndarray | None = None
     force_time: np.ndarray | None = None    # coupling window ends (s)
     axial_force: np.ndarray | None = None   # N (N/m in 2D), downstream positive
 
@@ -81,6 +96,12 @@ class ProbeSeries:
     def pressure_drop(self) -> np.ndarray:
         return self.upstream_pressure - self.downstream_pressure
 
+    @property
+    def centre_pressure_drop(self) -> np.ndarray:
+        if self.upstream_centre is None or self.downstream_centre is None:
+            return self.pressure_drop
+        return self.upstream_centre - self.downstream_centre
+
 
 @dataclass
 class CycleHemodynamics:
@@ -90,7 +111,7 @@ class CycleHemodynamics:
     forward_start_s: float          # t1, within the cycle (s from its start)
     forward_end_s: float            # t2
     mspd_mmHg: float
-    pspd_mmHg: float
+    pspd_mmHg: float                # smoothed, section-averaged
     pspd_time_s: float
     q_rms: float                    # mL/s (2D: cm^2/s)
     eoa: float                      # cm^2 (2D: cm)
@@ -109,6 +130,8 @@ class CycleHemodynamics:
     hydrostatic_force: float        # -Pmax * A, N (2D: N/m)
     water_hammer_ratio: float | None
     section_stroke_volumes: dict    # section -> forward volume over [t1, t2], mL (2D: cm^2)
+    pspd_probe_mmHg: float = float("nan")          # raw: the centre probes' largest dP over [t1, t2]
+    peak_particle_speed: float | None = None       # raw: fastest particle on the velocity plane (m/s)
 
 
 def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "downstream_tap",
@@ -127,7 +150,7 @@ def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "d
         for name in (upstream, downstream):
             if name not in f["pressure"]:
                 raise ValueError(f"{path}: no dataset '/pressure/{name}': have {', '.join(f['pressure'])}")
-        names = sections or list(f["flow_rate"])
+        names = sections or [name for name in f["flow_rate"] if name != JET_CORE_PLANE]
         missing = [name for name in names if name not in f["flow_rate"]]
         if missing:
             raise ValueError(f"{path}: no dataset '/flow_rate/{missing[0]}': have {', '.join(f['flow_rate'])}")
@@ -144,10 +167,18 @@ def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "d
         dimension = 3
         if "wall_force" in f and "fixed_walls" in f["wall_force"]:
             dimension = int(f["wall_force"]["fixed_walls"].shape[1])
+        def section_mean(tap):
+            probes = [tap] + sorted(n for n in f["pressure"] if n.startswith(tap + SECTION_SUFFIX))
+            return np.mean([f["pressure"][n][()].reshape(-1) for n in probes], axis=0)
+
         series = ProbeSeries(time=f["time"][()].reshape(-1),
-                             upstream_pressure=f["pressure"][upstream][()].reshape(-1),
-                             downstream_pressure=f["pressure"][downstream][()].reshape(-1),
-                             flow_rates=flows, max_velocity=velocity, dimension=dimension)
+                             upstream_pressure=section_mean(upstream),
+                             downstream_pressure=section_mean(downstream),
+                             flow_rates=flows, max_velocity=velocity, dimension=dimension,
+                             jet_core_flow=(f["flow_rate"][JET_CORE_PLANE][()].reshape(-1)
+                                            if JET_CORE_PLANE in f["flow_rate"] else None),
+                             upstream_centre=f["pressure"][upstream][()].reshape(-1),
+                             downstream_centre=f["pressure"][downstream][()].reshape(-1))
     coupling = run_dir / "coupling_series.h5"
     if coupling.exists():
         with h5py.File(coupling, "r") as f:
@@ -263,7 +294,9 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
     to_volume = 1e6 if series.dimension == 3 else 1e4
     mspd = integral(t, dp, t1, t2) / duration / PA_PER_MMHG
     in_forward = (t >= t1) & (t <= t2)
-    k = int(np.argmax(np.where(in_forward, dp, -np.inf)))
+    k = int(np.argmax(np.where(in_forward, moving_average(t, dp, smoothing_s), -np.inf)))
+    dp_smooth_peak = float(moving_average(t, dp, smoothing_s)[k])
+    pspd_probe = float(np.max(np.where(in_forward, series.centre_pressure_drop[sel], -np.inf))) / PA_PER_MMHG
     q_rms = math.sqrt(integral(t, q * q, t1, t2) / duration) * to_volume
     eoa = q_rms / (GORLIN_CONSTANT * math.sqrt(mspd)) if mspd > 0 else float("nan")
     t_close = closure_time(t, q_s, t2) if closure_time_s is None else start + closure_time_s
@@ -272,9 +305,16 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
     peak_q = float(np.max(q)) * to_volume
     sections = {name: integral(t, rate[sel] * symmetry_factor, t1, t2) * to_volume for name, rate in series.flow_rates.items()}
 
-    velocity = velocity_time = None
+    velocity = velocity_time = particle_speed = None
     if series.max_velocity is not None:
-        v = series.max_velocity[sel]
+        particle_speed = float(np.max(series.max_velocity[sel]))
+    if series.jet_core_flow is not None:
+        core_area = math.pi * JET_CORE_RADIUS_M ** 2 if series.dimension == 3 else 2 * JET_CORE_RADIUS_M
+        v = moving_average(t, series.jet_core_flow[sel] * symmetry_factor / core_area, smoothing_s)
+        kv = int(np.argmax(v))
+        velocity, velocity_time = float(v[kv]), float(t[kv] - start)
+    elif series.max_velocity is not None:   # older runs without a jet-core plane: the smoothed fastest particle
+        v = moving_average(t, series.max_velocity[sel], smoothing_s)
         kv = int(np.argmax(v))
         velocity, velocity_time = float(v[kv]), float(t[kv] - start)
     p_max = hydrostatic_Pa if hydrostatic_Pa is not None else hydrostatic_pressure_Pa()
@@ -292,13 +332,14 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
             ratio = diastolic / hydrostatic_force
     return CycleHemodynamics(
         cycle=cycle, dimension=series.dimension, forward_start_s=t1 - start, forward_end_s=t2 - start,
-        mspd_mmHg=mspd, pspd_mmHg=float(dp[k]) / PA_PER_MMHG, pspd_time_s=float(t[k] - start),
+        mspd_mmHg=mspd, pspd_mmHg=dp_smooth_peak / PA_PER_MMHG, pspd_time_s=float(t[k] - start),
         q_rms=q_rms, eoa=eoa, stroke_volume=integral(t, q, t1, t2) * to_volume,
         closing_volume=closing, leakage_volume=leakage, regurgitant_volume=closing + leakage,
         closure_time_s=t_close - start, peak_flow=peak_q, peak_flow_L_per_min=peak_q * 60.0 / 1000.0,
         peak_velocity_m_per_s=velocity, peak_velocity_time_s=velocity_time,
         pull_out_force=pull_out, diastolic_force=diastolic, diastolic_force_time_s=diastolic_time,
-        hydrostatic_force=hydrostatic_force, water_hammer_ratio=ratio, section_stroke_volumes=sections)
+        hydrostatic_force=hydrostatic_force, water_hammer_ratio=ratio, section_stroke_volumes=sections,
+        pspd_probe_mmHg=pspd_probe, peak_particle_speed=particle_speed)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -335,15 +376,17 @@ def hemodynamics_table(results: dict) -> str:
 
     spec = [
         ("MSPD (mmHg)", lambda r: _f(r.mspd_mmHg, 1), ref("mspd_mmHg", 1)),
-        ("PSPD (mmHg)", lambda r: _f(r.pspd_mmHg, 1), ref("pspd_mmHg", 1)),
+        ("PSPD, section mean, 2 ms smoothed (mmHg)", lambda r: _f(r.pspd_mmHg, 1), ref("pspd_mmHg", 1)),
         ("PSPD time (ms)", lambda r: _f(r.pspd_time_s, 0, 1e3), ref("pspd_time_s", 0, 1e3)),
+        ("— raw: centre probes' largest ΔP (mmHg)", lambda r: _f(r.pspd_probe_mmHg, 1), ["–"] * len(refs)),
         (f"EOA ({u['eoa']})", lambda r: _f(r.eoa, 2), ref("eoa", 2)),
         (f"regurgitant volume ({u['volume']})", lambda r: _f(r.regurgitant_volume, 2), ref("regurgitant_volume", 1)),
         (f"— closing ({u['volume']})", lambda r: _f(r.closing_volume, 2), ["–"] * len(refs)),
         (f"— leakage ({u['volume']})", lambda r: _f(r.leakage_volume, 2), ["–"] * len(refs)),
         (f"peak flow rate ({u['flow_min']})", lambda r: _f(r.peak_flow_L_per_min, 2), ref("peak_flow_L_per_min", 1)),
-        ("peak velocity 15 mm downstream (m/s)", lambda r: _f(r.peak_velocity_m_per_s, 2), ref("peak_velocity_m_per_s", 2)),
+        ("peak velocity 15 mm downstream, jet core (m/s)", lambda r: _f(r.peak_velocity_m_per_s, 2), ref("peak_velocity_m_per_s", 2)),
         ("peak velocity time (ms)", lambda r: _f(r.peak_velocity_time_s, 0, 1e3), ref("peak_velocity_time_s", 0, 1e3)),
+        ("— raw: fastest particle on the plane (m/s)", lambda r: _f(r.peak_particle_speed, 2), ["–"] * len(refs)),
         (f"peak pull-out force, systole ({u['force']})", lambda r: _f(r.pull_out_force, 3), ref("pull_out_force", 2)),
         (f"peak diastolic force ({u['force']})", lambda r: _f(r.diastolic_force, 2), ref("diastolic_force", 1)),
         ("diastolic force time (ms)", lambda r: _f(r.diastolic_force_time_s, 0, 1e3), ref("diastolic_force_time_s", 0, 1e3)),

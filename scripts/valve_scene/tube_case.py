@@ -29,6 +29,8 @@ from .valve_geometry import LEAFLET_COUNT, SECTOR_HALF_ANGLE, ValveParameters
 PLATE_LAYERS = 3                      # plate thickness in particle spacings
 STROKE_VOLUME_M3 = 60e-6              # generous: the reference's flow implies ~40 mL per beat
 VELOCITY_PROBE_DOWNSTREAM = 15e-3     # maximum velocity 15 mm downstream of the annulus (ref. Fig. 11c)
+SECTION_PROBE_FRACTIONS = (-0.6, -0.3, 0.3, 0.6)   # extra tap probes across a section, x the tube radius
+SECTOR_SECTION_AZIMUTHS_DEG = (10.0, 25.0, 35.0, 50.0)   # the sector's extra tap probes (inside its wedge)
 SKIRT_LAYERS = 3                      # skirt thickness in particle spacings: ceil(2h / dp) at h = 1.3 dp
 SECTOR_SKIRT_MARGIN = math.radians(15.0)  # skirt columns kept beyond the sector's mirror planes
 
@@ -162,8 +164,19 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
     ]
     tap_xy = ([SECTOR_TAP_RADIUS * math.cos(0.5 * SECTOR_HALF_ANGLE), SECTOR_TAP_RADIUS * math.sin(0.5 * SECTOR_HALF_ANGLE)]
               if sector else [0.0, 0.0])
+    from .hemodynamics import JET_CORE_PLANE, JET_CORE_RADIUS_M, SECTION_SUFFIX
     for name in ("upstream_tap", "downstream_tap"):
         lines.append(f"    pressure_points {{ name: \"{name}\" position: {_vec(tap_xy + [probes_z[name]])} }}")
+    lines.append("    # each tap is averaged over its cross-section (docs/hemodynamics.md): four more points at half the tube radius")
+    for name in ("upstream_tap", "downstream_tap"):
+        azimuths = (SECTOR_SECTION_AZIMUTHS_DEG if sector else (0.0, 90.0, 180.0, 270.0))
+        for k, azimuth in enumerate(azimuths, start=1):
+            a = math.radians(azimuth)
+            xy = [0.5 * R_tube * math.cos(a), 0.5 * R_tube * math.sin(a)]
+            lines.append(f"    pressure_points {{ name: \"{name}{SECTION_SUFFIX}{k}\" position: {_vec(xy + [probes_z[name]])} }}")
+    lines.append(f"    # the jet core 15 mm downstream: flow through r < {JET_CORE_RADIUS_M * 1e3:g} mm (peak speed = flow / area)")
+    lines.append(f"    flow_planes {{ name: \"{JET_CORE_PLANE}\" point: {_vec([0, 0, VELOCITY_PROBE_DOWNSTREAM])} normal: [0, 0, 1] "
+                 f"radius: {JET_CORE_RADIUS_M:.6g} }}")
     for name, z in probes_z.items():
         lines.append(f"    flow_planes {{ name: \"{name}\" point: {_vec([0, 0, z])} normal: [0, 0, 1] }}")
     lines.append(f"    velocity_planes {{ name: \"15mm_downstream\" point: {_vec([0, 0, VELOCITY_PROBE_DOWNSTREAM])} normal: [0, 0, 1] }}")

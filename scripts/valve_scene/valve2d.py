@@ -28,7 +28,8 @@ import numpy as np
 from . import waveform
 from .mesh_io import write_mesh
 from .tube import TubeSetup
-from .tube_case import aortic_pressure_at_opening_mmHg
+from .hemodynamics import JET_CORE_PLANE, JET_CORE_RADIUS_M, SECTION_SUFFIX
+from .tube_case import SECTION_PROBE_FRACTIONS, aortic_pressure_at_opening_mmHg
 from .valve_geometry import ValveParameters
 from .valve_mesh import ValveMesh, leaflet_grid
 
@@ -314,7 +315,14 @@ def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Chann
         "  probes {",
         f"    pressure_points {{ name: \"upstream_tap\" position: {_vec([-ch.upstream_tap_distance, 0])} }}",
         f"    pressure_points {{ name: \"downstream_tap\" position: {_vec([ch.downstream_tap_distance, 0])} }}",
+        "    # each tap is averaged over its cross-section (docs/hemodynamics.md): four more points across it",
     ]
+    for tap, x in (("upstream_tap", -ch.upstream_tap_distance), ("downstream_tap", ch.downstream_tap_distance)):
+        for k, fraction in enumerate(SECTION_PROBE_FRACTIONS, start=1):
+            lines.append(f"    pressure_points {{ name: \"{tap}{SECTION_SUFFIX}{k}\" position: {_vec([x, fraction * half])} }}")
+    lines.append(f"    # the jet core 15 mm downstream: flow through |y| < {JET_CORE_RADIUS_M * 1e3:g} mm (peak speed = flow / width)")
+    lines.append(f"    flow_planes {{ name: \"{JET_CORE_PLANE}\" point: {_vec([ch.velocity_probe_distance, 0])} normal: [1, 0] "
+                 f"radius: {JET_CORE_RADIUS_M:.6g} }}")
     for x in ch.flow_sections:
         lines.append(f"    flow_planes {{ name: \"{section_name(x)}\" point: {_vec([x, 0])} normal: [1, 0] }}")
     lines.append(f"    velocity_planes {{ name: \"{ch.velocity_probe_distance * 1e3:g}mm_downstream\" "

@@ -224,5 +224,55 @@ class Files(unittest.TestCase):
                 hd.read_run(Path(tmp), upstream="inlet")
 
 
+class Smoothed(unittest.TestCase):
+    """PSPD from the section-averaged, 2 ms smoothed drop and the jet-core speed: a one-sample
+    spike of one probe or one particle does not move them (docs/hemodynamics.md)."""
+
+    def write_spiky_run(self, folder: Path, dimension: int):
+        series = synthetic(dimension=dimension)
+        t = series.time
+        spike = np.zeros_like(t)
+        spike[int(round((T + 0.01) / DT))] = 200 * MMHG             # one sample of the centre tap
+        core_area = math.pi * hd.JET_CORE_RADIUS_M ** 2 if dimension == 3 else 2 * hd.JET_CORE_RADIUS_M
+        core_speed = 1.4 * np.sin(np.pi * np.clip(np.mod(t, T), 0, TE) / TE) ** 2
+        particle = core_speed * 1.2
+        particle[int(round((T + 0.4) / DT))] = 27.0                   # one particle squeezed out
+        with h5py.File(folder / "fluid_probes.h5", "w") as f:
+            f["time"] = t.reshape(-1, 1)
+            f["pressure/upstream_tap"] = (series.upstream_pressure + spike).reshape(-1, 1)
+            f["pressure/downstream_tap"] = series.downstream_pressure.reshape(-1, 1)
+            for k in range(1, 5):
+                f[f"pressure/upstream_tap_section_{k}"] = series.upstream_pressure.reshape(-1, 1)
+                f[f"pressure/downstream_tap_section_{k}"] = series.downstream_pressure.reshape(-1, 1)
+            for name, q in series.flow_rates.items():
+                f[f"flow_rate/{name}"] = q.reshape(-1, 1)
+            f[f"flow_rate/{hd.JET_CORE_PLANE}"] = (core_speed * core_area).reshape(-1, 1)
+            f["max_velocity/15mm_downstream"] = particle.reshape(-1, 1)
+            f["wall_force/fixed_walls"] = np.zeros((len(t), dimension))
+
+    def test_spikes_do_not_move_pspd_and_peak_speed(self):
+        for dimension in (2, 3):
+            with tempfile.TemporaryDirectory() as tmp:
+                self.write_spiky_run(Path(tmp), dimension)
+                series = hd.read_run(Path(tmp))
+            self.assertEqual(sorted(series.flow_rates), ["a", "b"])   # the core is not a flow section
+            r = hd.analyse_cycle(series, cycle=2, smoothing_s=0.002)
+            self.assertAlmostEqual(r.pspd_mmHg, 8.0, delta=0.01)
+            self.assertAlmostEqual(r.pspd_time_s, TE / 2, delta=0.002)
+            self.assertAlmostEqual(r.pspd_probe_mmHg, 5.0 + 3.0 * math.sin(math.pi * 0.01 / TE) ** 2 + 200, delta=0.01)
+            self.assertLessEqual(abs(r.mspd_mmHg - 6.5), 40 * DT / TE + 1e-6)   # the mean keeps at most the spike's share
+            self.assertAlmostEqual(r.peak_velocity_m_per_s, 1.4, delta=0.002)
+            self.assertAlmostEqual(r.peak_velocity_time_s, TE / 2, delta=0.002)
+            self.assertAlmostEqual(r.peak_particle_speed, 27.0, delta=1e-9)
+
+    def test_sector_core_flow_times_six(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            self.write_spiky_run(Path(tmp), 3)
+            series = hd.read_run(Path(tmp))
+        series.jet_core_flow = series.jet_core_flow / 6
+        r = hd.analyse_cycle(series, cycle=2, smoothing_s=0.002, symmetry_factor=6)
+        self.assertAlmostEqual(r.peak_velocity_m_per_s, 1.4, delta=0.002)
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -42,6 +42,26 @@ ImmersedSurfaceGeometry<3> read_surface(const std::string& file) {
   return g;
 }
 
+// Diagnostics: every fluid particle (near the surface or not) with its kernel sum C and grad C
+// (the case must switch shifting on), distance and side from the surface, and whether its
+// closest point is on the free boundary.
+void write_particle_dump(const std::string& file, const FluidSolver<3>& solver, const ThinWallModel3D& model) {
+  const auto& p = solver.particles();
+  std::ofstream out(file);
+  out << "x,y,z,C,gx,gy,gz,near,d,side,boundary,vx,vy,vz,p\n";
+  const bool with_c = p.kernel_sum.size() == p.size();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.kind[i] != Kind::fluid) continue;
+    const Vec3 x{p.position[0][i], p.position[1][i], p.position[2][i]};
+    const auto c = closest_point(model.mesh(), x);
+    out << x[0] << ',' << x[1] << ',' << x[2] << ',' << (with_c ? p.kernel_sum[i] : 0.f) << ','
+        << (with_c ? p.kernel_sum_gradient[0][i] : 0.f) << ',' << (with_c ? p.kernel_sum_gradient[1][i] : 0.f) << ','
+        << (with_c ? p.kernel_sum_gradient[2][i] : 0.f) << ',' << (model.near_surface(i) ? 1 : 0) << ',' << c.distance << ','
+        << c.side << ',' << (c.on_boundary ? 1 : 0) << ',' << p.velocity[0][i] << ',' << p.velocity[1][i] << ','
+        << p.velocity[2][i] << ',' << p.pressure[i] - solver.settings().background_pressure << '\n';
+  }
+}
+
 // The fluid part of a case (e.g. the coupled sector) at rest with the solid's surface at
 // rest in it, for a number of steps: loads at rest, leaks and the cost per step, with and
 // without the surface.
@@ -78,6 +98,7 @@ int run_case_at_rest(const std::string& case_file, const std::string& surface_fi
     for (int k = 0; k < 2; ++k)
       std::printf("side %+d: %zu near particles, kernel sum mean %.4f, lowest %.4f\n", k ? 1 : -1, count[k],
                   count[k] ? sum[k] / static_cast<double>(count[k]) : 0.0, low[k]);
+    if (const char* dump = std::getenv("THIN_WALL_PARTICLE_DUMP")) write_particle_dump(dump, solver, *model);
   }
   const auto t0 = std::chrono::steady_clock::now();
   for (long k = 0; k < steps; ++k) solver.step();
@@ -85,6 +106,7 @@ int run_case_at_rest(const std::string& case_file, const std::string& surface_fi
   std::printf("%s: %zu particles, %ld steps to t = %.3g s, %.2f s, %.2f ms/step\n", no_surface ? "no surface" : "with surface",
               solver.particles().size(), steps, solver.time(), wall, 1e3 * wall / static_cast<double>(steps));
   if (model) {
+    if (const char* dump = std::getenv("THIN_WALL_PARTICLE_DUMP_END")) write_particle_dump(dump, solver, *model);
     const auto k = model->counters();
     const Vec3 f = model->total_force();
     double largest = 0;

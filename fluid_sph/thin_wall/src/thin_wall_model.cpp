@@ -194,6 +194,25 @@ void ThinWallModel2D::restore_checkpoint() {
   move_to(motion_.current_time());
 }
 
+std::optional<std::vector<NamedArray>> ThinWallModel2D::restart_state() const {
+  RestartWriter out;
+  motion_.save(out, "motion");
+  for (std::size_t c = 0; c < walls_.size(); ++c) walls_[c].save_state(out, fmt::format("wall{}", c));
+  return out.take();
+}
+
+void ThinWallModel2D::load_restart_state(std::span<const NamedArray> arrays) {
+  const RestartReader in(arrays, "thin wall 2D restart state");
+  // Read into copies first, so that a bad array leaves the model as it was.
+  WindowMotion motion = motion_;
+  motion.load(in, "motion");
+  std::vector<TwoSidedWall> walls = walls_;
+  for (std::size_t c = 0; c < walls.size(); ++c) walls[c].load_state(in, fmt::format("wall{}", c));
+  motion_ = std::move(motion);
+  walls_ = std::move(walls);
+  motion_.evaluate(motion_.current_time(), x_, v_, a_);
+}
+
 std::unique_ptr<ImmersedSurfaceModel<2>> make_thin_wall_model_2d(const ImmersedSurfaceGeometry<2>& geometry,
                                                                  const FluidSettings<2>& fluid,
                                                                  const valvefsi::cases::FluidThinWalls& walls) {

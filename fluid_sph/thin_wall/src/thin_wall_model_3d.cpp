@@ -11,6 +11,7 @@
 #include "valvefsi/case/case_loader.hpp"
 #include "valvefsi/fluid/equation_of_state.hpp"
 #include "valvefsi/fluid/kernels.hpp"
+#include "valvefsi/fluid/thin_wall/restart_arrays.hpp"
 
 namespace valvefsi::fluid::thin_wall {
 namespace {
@@ -479,7 +480,9 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
     {
       Vec3* forces = per_thread.data() + static_cast<std::size_t>(omp_get_thread_num()) * node_count_;
       std::vector<double> side_a;  // signed distance of the particle from each candidate's plane
-#pragma omp for schedule(dynamic, 16)
+      // Static chunks: each thread's share, and so the node loads' summation order, is the
+      // same in every run with the same thread count (restarts continue bit for bit).
+#pragma omp for schedule(static, 16)
       for (std::ptrdiff_t aa = 0; aa < count; ++aa) {
         const auto a = static_cast<std::size_t>(aa);
         if (p.kind[a] != Kind::fluid || !s.near[a].near) continue;
@@ -649,6 +652,100 @@ void ThinWallModel3D::save_checkpoint() { checkpoint_ = dyn_; }
 void ThinWallModel3D::restore_checkpoint() {
   if (!checkpoint_) throw std::logic_error("thin wall 3D restore_checkpoint: no checkpoint was saved");
   dyn_ = *checkpoint_;
+  place_mesh();
+}
+
+std::optional<std::vector<NamedArray>> ThinWallModel3D::restart_state() const {
+  const auto& s = dyn_;
+  RestartWriter out;
+  s.motion.save(out, "motion");
+  out.vectors("nodes.x", s.x);
+  out.vectors("nodes.v", s.v);
+  out.vectors("nodes.a", s.a);
+  // Before the first evaluation the states and loads are empty: written as their defaults.
+  std::vector<std::array<double, 10>> states(node_count_, std::array<double, 10>{});
+  for (std::size_t j = 0; j < std::min(s.state.size(), node_count_); ++j)
+    for (std::size_t k = 0; k < 2; ++k) {
+      const SideState& st = s.state[j].side[k];
+      states[j][5 * k] = st.pressure;
+      for (std::size_t d = 0; d < 3; ++d) states[j][5 * k + 1 + d] = st.velocity[d];
+      states[j][5 * k + 4] = st.weight;
+    }
+  out.vectors("nodes.side_states", states);
+  std::vector<Vec3> force = s.force;
+  force.resize(node_count_, Vec3{0, 0, 0});
+  out.vectors("nodes.force", force);
+  std::vector<std::array<double, 11>> near(s.near.size());
+  for (std::size_t i = 0; i < s.near.size(); ++i) {
+    const ClosestPoint3& c = s.near[i].closest;
+    near[i] = {s.near[i].near ? 1.0 : 0.0, static_cast<double>(c.triangle), c.barycentric[0], c.barycentric[1], c.barycentric[2],
+               c.point[0], c.point[1], c.point[2], c.distance, static_cast<double>(c.side), c.on_boundary ? 1.0 : 0.0};
+  }
+  out.vectors("particles.near", near);
+  out.lists("particles.candidates", s.candidates);
+  out.vectors("particles.start_position", s.start_position);
+  out.vectors("nodes.start_position", s.start_nodes);
+  out.scalars("by_id.side", s.side_by_id);
+  out.scalars("by_id.corrected", s.corrected_by_id);
+  out.vectors("by_id.previous_position", s.previous_by_id);
+  out.scalars("counters", std::vector<double>{static_cast<double>(s.counters.corrections), static_cast<double>(s.counters.leaks),
+                                              static_cast<double>(s.counters.rejected_shifts)});
+  return out.take();
+}
+
+void ThinWallModel3D::load_restart_state(std::span<const NamedArray> arrays) {
+  const RestartReader in(arrays, "thin wall 3D restart state");
+  Dynamic s = dyn_;
+  s.motion.load(in, "motion");
+  s.x = in.vectors<3>("nodes.x", node_count_);
+  s.v = in.vectors<3>("nodes.v", node_count_);
+  s.a = in.vectors<3>("nodes.a", node_count_);
+  const auto states = in.vectors<10>("nodes.side_states", node_count_);
+  s.state.assign(node_count_, NodeState{});
+  for (std::size_t j = 0; j < node_count_; ++j)
+    for (std::size_t k = 0; k < 2; ++k) {
+      SideState& st = s.state[j].side[k];
+      st.pressure = states[j][5 * k];
+      for (std::size_t d = 0; d < 3; ++d) st.velocity[d] = states[j][5 * k + 1 + d];
+      st.weight = states[j][5 * k + 4];
+    }
+  s.force = in.vectors<3>("nodes.force", node_count_);
+  const auto near = in.vectors<11>("particles.near");
+  s.near.assign(near.size(), NearWall{});
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    const auto& e = near[i];
+    if (e[1] < 0 || e[1] >= static_cast<double>(mesh_.triangles.size()))
+      throw std::runtime_error(fmt::format("thin wall 3D restart state: array 'particles.near' names triangle {} for particle {}: "
+                                           "allowed 0 to {}",
+                                           e[1], i, mesh_.triangles.size() - 1));
+    s.near[i].near = e[0] != 0.0;
+    ClosestPoint3& c = s.near[i].closest;
+    c.triangle = static_cast<std::size_t>(e[1]);
+    c.barycentric = {e[2], e[3], e[4]};
+    c.point = {e[5], e[6], e[7]};
+    c.distance = e[8];
+    c.side = static_cast<int>(e[9]);
+    c.on_boundary = e[10] != 0.0;
+  }
+  s.candidates = in.lists("particles.candidates", near.size());
+  for (const auto& list : s.candidates)
+    for (const auto t : list)
+      if (t >= mesh_.triangles.size())
+        throw std::runtime_error(fmt::format("thin wall 3D restart state: array 'particles.candidates.values' names triangle {}: "
+                                             "allowed 0 to {}",
+                                             t, mesh_.triangles.size() - 1));
+  s.start_position = in.vectors<3>("particles.start_position");
+  s.start_nodes = in.vectors<3>("nodes.start_position");
+  if (!s.start_nodes.empty() && s.start_nodes.size() != mesh_.position.size())
+    throw std::runtime_error(fmt::format("thin wall 3D restart state: array 'nodes.start_position' has {} nodes: allowed 0 or {} "
+                                         "(the leaflet with its mirror images)",
+                                         s.start_nodes.size(), mesh_.position.size()));
+  s.side_by_id = in.scalars<std::int8_t>("by_id.side");
+  s.corrected_by_id = in.scalars<std::uint8_t>("by_id.corrected");
+  s.previous_by_id = in.vectors<3>("by_id.previous_position");
+  const auto counters = in.scalars<std::size_t>("counters", 3);
+  s.counters = {counters[0], counters[1], counters[2]};
+  dyn_ = std::move(s);
   place_mesh();
 }
 

@@ -1,5 +1,6 @@
 #include "valvefsi/fluid/thin_wall/two_sided_wall.hpp"
 
+#include <fmt/format.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -165,7 +166,9 @@ void TwoSidedWall::add_wall_rates(Particles<2>& p) {
   std::vector<Vec2> per_thread(static_cast<std::size_t>(threads) * markers_.size(), Vec2{0.0, 0.0});
   const auto count = static_cast<std::ptrdiff_t>(p.size());
   with_kernel<2>(fluid_.kernel, h, [&](const auto& W) {
-#pragma omp parallel for schedule(dynamic, 16)
+    // Static chunks: the markers' loads are summed in the same order in every run with the
+    // same thread count (restarts continue bit for bit).
+#pragma omp parallel for schedule(static, 16)
     for (std::ptrdiff_t aa = 0; aa < count; ++aa) {
       const auto a = static_cast<std::size_t>(aa);
       if (p.kind[a] != Kind::fluid || !near_[a].near) continue;
@@ -371,6 +374,106 @@ bool TwoSidedWall::accept_shift(const Particles<2>& p, std::size_t i, const Vec2
     ++counters_.rejected_shifts;
   }
   return ok;
+}
+
+void TwoSidedWall::save_state(RestartWriter& out, const std::string& prefix) const {
+  out.vectors(prefix + ".nodes.x", wall_.position);
+  out.vectors(prefix + ".nodes.v", wall_.velocity);
+  out.vectors(prefix + ".nodes.a", wall_.acceleration);
+  out.vectors(prefix + ".nodes.start_position", start_nodes_);
+  std::vector<std::array<double, 10>> markers(markers_.size());
+  for (std::size_t m = 0; m < markers_.size(); ++m) {
+    const Marker& mk = markers_[m];
+    for (std::size_t k = 0; k < 2; ++k) {
+      markers[m][4 * k] = mk.side[k].pressure;
+      markers[m][4 * k + 1] = mk.side[k].extrapolated_velocity[0];
+      markers[m][4 * k + 2] = mk.side[k].extrapolated_velocity[1];
+      markers[m][4 * k + 3] = mk.side[k].weight;
+    }
+    markers[m][8] = mk.force[0];
+    markers[m][9] = mk.force[1];
+  }
+  out.vectors(prefix + ".markers", markers);
+  out.scalars(prefix + ".counters", std::vector<double>{static_cast<double>(counters_.corrections), static_cast<double>(counters_.leaks),
+                                                         static_cast<double>(counters_.rejected_shifts)});
+  std::vector<std::array<double, 8>> near(near_.size());
+  for (std::size_t i = 0; i < near_.size(); ++i) {
+    const ClosestPoint& c = near_[i].closest;
+    near[i] = {near_[i].near ? 1.0 : 0.0, static_cast<double>(c.segment), c.t, c.point[0], c.point[1], c.distance,
+               static_cast<double>(c.side), c.at_free_end ? 1.0 : 0.0};
+  }
+  out.vectors(prefix + ".particles.near", near);
+  out.lists(prefix + ".particles.candidates", candidates_);
+  out.vectors(prefix + ".particles.start_position", start_position_);
+  out.scalars(prefix + ".particles.virtual_kernel_sum", virtual_kernel_sum_);
+  out.scalars(prefix + ".by_id.side", side_by_id_);
+  out.scalars(prefix + ".by_id.corrected", corrected_by_id_);
+  out.vectors(prefix + ".by_id.previous_position", previous_by_id_);
+  out.scalars(prefix + ".box", std::vector<double>(wall_box_.begin(), wall_box_.end()));
+}
+
+void TwoSidedWall::load_state(const RestartReader& in, const std::string& prefix) {
+  const std::size_t nodes = wall_.node_count();
+  auto position = in.vectors<2>(prefix + ".nodes.x", nodes);
+  auto velocity = in.vectors<2>(prefix + ".nodes.v", nodes);
+  auto acceleration = in.vectors<2>(prefix + ".nodes.a", nodes);
+  auto start_nodes = in.vectors<2>(prefix + ".nodes.start_position");
+  if (!start_nodes.empty() && start_nodes.size() != nodes)
+    throw std::runtime_error(fmt::format("{}: array '{}.nodes.start_position' has {} nodes: allowed 0 or {}", in.owner(), prefix,
+                                         start_nodes.size(), nodes));
+  const auto markers = in.vectors<10>(prefix + ".markers", markers_.size());
+  const auto counters = in.scalars<std::size_t>(prefix + ".counters", 3);
+  const auto near = in.vectors<8>(prefix + ".particles.near");
+  auto candidates = in.lists(prefix + ".particles.candidates", near.size());
+  for (const auto& list : candidates)
+    for (const auto k : list)
+      if (k >= wall_.segment_count())
+        throw std::runtime_error(fmt::format("{}: array '{}.particles.candidates.values' names segment {}: allowed 0 to {}", in.owner(),
+                                             prefix, k, wall_.segment_count() - 1));
+  std::vector<NearWall> near_walls(near.size());
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    const auto& e = near[i];
+    if (e[1] < 0 || e[1] >= static_cast<double>(wall_.segment_count()))
+      throw std::runtime_error(fmt::format("{}: array '{}.particles.near' names segment {} for particle {}: allowed 0 to {}", in.owner(),
+                                           prefix, e[1], i, wall_.segment_count() - 1));
+    near_walls[i].near = e[0] != 0.0;
+    ClosestPoint& c = near_walls[i].closest;
+    c.segment = static_cast<std::size_t>(e[1]);
+    c.t = e[2];
+    c.point = {e[3], e[4]};
+    c.distance = e[5];
+    c.side = static_cast<int>(e[6]);
+    c.at_free_end = e[7] != 0.0;
+  }
+  auto start_position = in.vectors<2>(prefix + ".particles.start_position");
+  auto kernel_sum = in.scalars<float>(prefix + ".particles.virtual_kernel_sum");
+  auto side_by_id = in.scalars<std::int8_t>(prefix + ".by_id.side");
+  auto corrected_by_id = in.scalars<std::uint8_t>(prefix + ".by_id.corrected");
+  auto previous_by_id = in.vectors<2>(prefix + ".by_id.previous_position");
+  const auto box = in.scalars<double>(prefix + ".box", 4);
+
+  wall_.position = std::move(position);
+  wall_.velocity = std::move(velocity);
+  wall_.acceleration = std::move(acceleration);
+  start_nodes_ = std::move(start_nodes);
+  for (std::size_t m = 0; m < markers_.size(); ++m) {
+    Marker& mk = markers_[m];
+    for (std::size_t k = 0; k < 2; ++k) {
+      mk.side[k].pressure = markers[m][4 * k];
+      mk.side[k].extrapolated_velocity = {markers[m][4 * k + 1], markers[m][4 * k + 2]};
+      mk.side[k].weight = markers[m][4 * k + 3];
+    }
+    mk.force = {markers[m][8], markers[m][9]};
+  }
+  counters_ = {counters[0], counters[1], counters[2]};
+  near_ = std::move(near_walls);
+  candidates_ = std::move(candidates);
+  start_position_ = std::move(start_position);
+  virtual_kernel_sum_ = std::move(kernel_sum);
+  side_by_id_ = std::move(side_by_id);
+  corrected_by_id_ = std::move(corrected_by_id);
+  previous_by_id_ = std::move(previous_by_id);
+  wall_box_ = {box[0], box[1], box[2], box[3]};
 }
 
 }  // namespace valvefsi::fluid::thin_wall

@@ -6,6 +6,7 @@
 // fluid's force on the coupler's nodes (N per metre of depth). docs/thin-leaflet.md.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -52,6 +53,12 @@ class ThinWallModel2D final : public ImmersedSurfaceModel<2> {
 
   void save_checkpoint() override;
   void restore_checkpoint() override;
+
+  // Restart files: the window's motion ("motion.*") and every chain's state ("wall<k>.*":
+  // nodes, markers, counters, per-particle data in the particle order of the moment, side
+  // memory by particle id).
+  std::optional<std::vector<NamedArray>> restart_state() const override;
+  void load_restart_state(std::span<const NamedArray> arrays) override;
 
   // Diagnostics and tests.
   const std::vector<std::vector<std::uint32_t>>& chains() const { return chains_; }

@@ -84,6 +84,12 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
   void save_checkpoint() override;
   void restore_checkpoint() override;
 
+  // Restart files: the window's motion, the nodes' states and loads, the counters, the side
+  // memory by particle id and the last classify's per-particle data in the particle order of
+  // the moment (arrays named "motion.*", "nodes.*", "by_id.*", "particles.*", "counters").
+  std::optional<std::vector<NamedArray>> restart_state() const override;
+  void load_restart_state(std::span<const NamedArray> arrays) override;
+
   // Diagnostics and tests.
   struct SideState {
     double pressure = 0.0;    // Pa (with the background pressure, as the fluid's)

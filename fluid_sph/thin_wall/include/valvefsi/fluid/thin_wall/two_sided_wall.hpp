@@ -14,6 +14,7 @@
 //   accept_shift      - particle shifting never crosses or touches the wall
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "valvefsi/fluid/cell_grid.hpp"
@@ -21,6 +22,7 @@
 #include "valvefsi/fluid/particles.hpp"
 #include "valvefsi/fluid/thin_wall/markers.hpp"
 #include "valvefsi/fluid/thin_wall/polyline.hpp"
+#include "valvefsi/fluid/thin_wall/restart_arrays.hpp"
 
 namespace valvefsi::fluid::thin_wall {
 
@@ -104,6 +106,13 @@ class TwoSidedWall {
   void correct_crossings(Particles<2>& particles);
   // Whether moving fluid particle i (sorted index) from its position by `shift` is allowed.
   bool accept_shift(const Particles<2>& particles, std::size_t i, const Vec2& shift);
+
+  // Restart state (arrays named under `prefix`): the wall's nodes, the markers' states and
+  // forces, counters, the last classify's per-particle data in the particle order of the
+  // moment, and the side memory by particle id. load_state throws std::runtime_error naming
+  // an array that is missing or of the wrong size.
+  void save_state(RestartWriter& out, const std::string& prefix) const;
+  void load_state(const RestartReader& in, const std::string& prefix);
 
   // Sum of the virtual-layer kernel weights seen by particle i at the last add_wall_rates
   // (diagnostics of kernel completeness near the edge).

@@ -12,7 +12,10 @@
 #include <cstddef>
 #include <span>
 #include <stdexcept>
+#include <string>
 #include <vector>
+
+#include "valvefsi/fluid/thin_wall/restart_arrays.hpp"
 
 namespace valvefsi::fluid::thin_wall {
 
@@ -85,6 +88,30 @@ class WindowMotionT {
     current_time_ = time;
     x_ = x;
     v_ = v;
+  }
+
+  // Restart state: the window's times and all node states (names under `prefix`).
+  void save(RestartWriter& out, const std::string& prefix) const {
+    out.scalars(prefix + ".times", std::vector<double>{start_time_, end_time_, current_time_});
+    out.vectors(prefix + ".x0", x0_);
+    out.vectors(prefix + ".v0", v0_);
+    out.vectors(prefix + ".x1", x1_);
+    out.vectors(prefix + ".v1", v1_);
+    out.vectors(prefix + ".x", x_);
+    out.vectors(prefix + ".v", v_);
+  }
+  void load(const RestartReader& in, const std::string& prefix) {
+    const auto times = in.scalars<double>(prefix + ".times", 3);
+    const std::size_t n = x_.size();
+    x0_ = in.vectors<D>(prefix + ".x0", n);
+    v0_ = in.vectors<D>(prefix + ".v0", n);
+    x1_ = in.vectors<D>(prefix + ".x1", n);
+    v1_ = in.vectors<D>(prefix + ".v1", n);
+    x_ = in.vectors<D>(prefix + ".x", n);
+    v_ = in.vectors<D>(prefix + ".v", n);
+    start_time_ = times[0];
+    end_time_ = times[1];
+    current_time_ = times[2];
   }
 
   double current_time() const { return current_time_; }

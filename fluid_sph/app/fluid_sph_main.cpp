@@ -2,7 +2,8 @@
 // the fluid participant of a coupled run.
 //   fluid_sph --case CASE [--output DIR] [--threads N] [--coupled | --standalone]
 // Coupled when the launcher set VALVEFSI_COUPLER_ENDPOINT (scripts/run_case.py does) or with
-// --coupled; --standalone runs alone whatever the environment says.
+// --coupled; --standalone runs alone whatever the environment says. Under mpirun -np N the
+// fluid is split into N slabs along its last axis (docs/fluid_sph.md, "MPI").
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
@@ -10,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "mpi_world.hpp"
 #include "participant_mode.hpp"
 #include "run_output.hpp"
 #include "valvefsi/case/case_loader.hpp"
@@ -26,15 +28,18 @@ int run_standalone(const valvefsi::cases::Case& c, const std::filesystem::path& 
   const ProbeSet<D> probes = setup.probes;
   const std::size_t plate_count = setup.plates.size();
   FluidSolver<D> solver = make_solver<D>(std::move(setup));
+  const app::MpiWorld world = app::mpi_world();
+  if (world.split()) solver.decompose(MPI_COMM_WORLD);
   solver.compute_body_forces_every_step(probes.wall_forces);
-  const auto& p = solver.particles();
-  spdlog::info("fluid_sph: {}D, {} fluid + {} wall particles, dp = {} m, h = {} m, c0 = {} m/s, {} plate(s), {} OpenMP thread(s)", D,
-               p.count(Kind::fluid), p.count(Kind::wall), solver.settings().particle_spacing, solver.settings().smoothing_length(),
-               solver.settings().sound_speed, plate_count, omp_get_max_threads());
+  const std::size_t fluid_count = app::count_over_ranks(solver, Kind::fluid);
+  const std::size_t wall_count = app::count_over_ranks(solver, Kind::wall);
+  spdlog::info("fluid_sph: {}D, {} fluid + {} wall particles, dp = {} m, h = {} m, c0 = {} m/s, {} plate(s), {} OpenMP thread(s) x {} MPI rank(s)",
+               D, fluid_count, wall_count, solver.settings().particle_spacing, solver.settings().smoothing_length(),
+               solver.settings().sound_speed, plate_count, omp_get_max_threads(), world.size);
 
   const double end_time = c.run().end_time();
   app::RunOutput<D> run_output(probes, plate_count, false, output, end_time, c.run().snapshot_interval(),
-                               c.run().series_interval());
+                               c.run().series_interval(), world.root());
   const long first_step = solver.step_count();
   while (true) {
     run_output.write_due(solver);
@@ -47,7 +52,7 @@ int run_standalone(const valvefsi::cases::Case& c, const std::filesystem::path& 
   }
   run_output.flush();
   const double wall = run_output.elapsed();
-  const double updates = static_cast<double>(p.size()) * static_cast<double>(solver.step_count() - first_step);
+  const double updates = app::particles_over_ranks(solver) * static_cast<double>(solver.step_count() - first_step);
   spdlog::info("fluid_sph: done, t = {} s in {} steps, wall time {:.1f} s ({:.3g} particle updates/s), {} particle(s) lost ({} of them by density out of range), output in {}",
                solver.time(), solver.step_count(), wall, updates / std::max(wall, 1e-9), solver.lost_count(),
                solver.density_out_of_range_count(), output.string());
@@ -56,7 +61,7 @@ int run_standalone(const valvefsi::cases::Case& c, const std::filesystem::path& 
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{"fluid_sph: weakly compressible SPH blood flow with rigid walls and pressure plates"};
   std::string case_path, output_dir;
   int threads = 0;
@@ -81,4 +86,20 @@ int main(int argc, char** argv) {
     spdlog::error("fluid_sph: {}", e.what());
     return 1;
   }
+}
+
+int main(int argc, char** argv) {
+  // MPI only under a launcher; a rank that fails takes the others down (they would wait on it).
+  const bool mpi = app::started_by_mpi_launcher();
+  if (mpi) {
+    int provided = 0;
+    MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+    if (!app::mpi_world().root()) spdlog::set_level(spdlog::level::warn);
+  }
+  const int code = run(argc, argv);
+  if (mpi) {
+    if (code != 0 && app::mpi_world().split()) MPI_Abort(MPI_COMM_WORLD, code);
+    MPI_Finalize();
+  }
+  return code;
 }

@@ -25,9 +25,11 @@ class RunOutput {
  public:
   using Clock = std::chrono::steady_clock;
 
+  // `root`: this process writes the files (rank 0 of a split run; the others only take part
+  // in the collective probes and snapshot gathers).
   RunOutput(const ProbeSet<D>& probes, std::size_t plate_count, bool interface_columns, const std::filesystem::path& output,
-            double end_time, double snapshot_interval, double series_interval)
-      : probes_(probes), plate_count_(plate_count), interface_(interface_columns), snapshots_(output),
+            double end_time, double snapshot_interval, double series_interval, bool root = true)
+      : probes_(probes), plate_count_(plate_count), interface_(interface_columns), root_(root), snapshots_(output, root),
         series_(output / "fluid_probes.h5"), end_time_(end_time), snapshot_interval_(snapshot_interval),
         series_interval_(series_interval), start_(Clock::now()), last_report_(start_) {
     for (const auto& q : probes.pressure_points) series_.add_column("pressure/" + q.name);
@@ -63,7 +65,7 @@ class RunOutput {
         while (next_sample_ <= t * (1 + 1e-12)) next_sample_ += series_interval_;
       else
         next_sample_ = t;
-      if (series_.samples() % 200 == 0) series_.flush();
+      if (series_.samples() % 200 == 0) flush();
     }
     const auto now = Clock::now();
     if (std::chrono::duration<double>(now - last_report_).count() > 10.0) {
@@ -83,7 +85,9 @@ class RunOutput {
     return target;
   }
 
-  void flush() { series_.flush(); }
+  void flush() {
+    if (root_) series_.flush();
+  }
   double elapsed() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
 
  private:
@@ -113,6 +117,7 @@ class RunOutput {
   ProbeSet<D> probes_;
   std::size_t plate_count_;
   bool interface_;
+  bool root_;
   SnapshotWriter<D> snapshots_;
   SeriesWriter series_;
   double end_time_, snapshot_interval_, series_interval_;

@@ -41,6 +41,14 @@ std::size_t CellGrid<D>::cell_of(const Particles<D>& p, std::size_t i) const {
 }
 
 template <int D>
+void CellGrid<D>::set_cell_starts(std::vector<std::uint32_t> starts) {
+  if (starts.size() != start_.size())
+    throw std::invalid_argument("CellGrid: " + std::to_string(starts.size()) + " cell starts for a grid of " +
+                                std::to_string(start_.size()) + " (another domain or spacing?)");
+  start_ = std::move(starts);
+}
+
+template <int D>
 std::size_t CellGrid<D>::wrap_and_mark_lost(Particles<D>& p) const {
   const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(p.size());
   std::size_t newly_lost = 0;

@@ -8,6 +8,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include "valvefsi/fluid/interactions.hpp"
 
@@ -44,6 +45,7 @@ struct FluidSolver<D>::Checkpoint {
   long steps = 0;
   std::size_t lost = 0, lost_density = 0;
   float max_speed = 0.0f, max_acceleration = 0.0f;
+  std::size_t owned_begin = 0, owned_end = 0;
 };
 
 template <int D>
@@ -70,17 +72,58 @@ FluidSolver<D>::FluidSolver(const FluidSettings<D>& settings, Particles<D> parti
   refresh_mirror_images();
   lost_ = grid_.wrap_and_mark_lost(particles_);
   grid_.sort(particles_);
+  update_owned_range();
   if (surface_) classify_surface();
   evaluate_rates();
   choose_time_step();
 }
 
 template <int D>
+void FluidSolver<D>::update_owned_range() {
+  if (slabs_) {
+    std::tie(owned_begin_, owned_end_) = slabs_->owned_range(grid_);
+  } else {
+    owned_begin_ = 0;
+    owned_end_ = particles_.size();
+  }
+}
+
+template <int D>
+void FluidSolver<D>::decompose(MPI_Comm comm) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  if (size == 1) return;
+  if (steps_ != 0) throw std::logic_error("FluidSolver::decompose: call it before the first step");
+  if (surface_)
+    throw std::invalid_argument("fluid MPI decomposition: immersed surfaces (leaflets) run on one rank only; "
+                                "run fluid_sph without mpirun (or -np 1) for this case");
+  constexpr int axis = SlabDecomposition<D>::kAxis;
+  for (const auto& plane : settings_.mirror_planes)
+    if (std::abs(plane.normal[axis]) > 1e-12)
+      throw std::invalid_argument(fmt::format("fluid MPI decomposition: a mirror plane's normal has a component {} along "
+                                              "the slab axis {}; allowed 0 (planes containing the axis, like a sector's) "
+                                              "or run on one rank", plane.normal[axis], axis));
+  slabs_ = std::make_unique<SlabDecomposition<D>>(comm, grid_, particles_);
+  slabs_->keep_own_and_halo(particles_);
+  add_mirror_images();
+  grid_.sort(particles_);
+  update_owned_range();
+  evaluate_rates();
+  max_speed_ = max_acceleration_ = 0.0f;
+  choose_time_step();
+}
+
+template <int D>
 void FluidSolver<D>::refresh_mirror_images() {
+  drop_mirror_images_and_reflect();
+  add_mirror_images();
+}
+
+template <int D>
+void FluidSolver<D>::drop_mirror_images_and_reflect() {
   if (settings_.mirror_planes.empty()) return;
   auto& p = particles_;
-  // Drop last step's images (compacting every array), then mirror every fluid and wall
-  // particle within a support of a plane: x' = x - 2 d n, v' = v - 2 (v.n) n.
+  // Drop last step's images (compacting every array); add_mirror_images makes new ones.
   // One tight loop per array (the images are spread over the cells after the sort, so nearly
   // every particle moves): the arrays are compacted in parallel, each in place in order.
   mirror_keep_.clear();
@@ -96,7 +139,6 @@ void FluidSolver<D>::refresh_mirror_images() {
   });
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::size_t c = 0; c < compactions.size(); ++c) compactions[c]();
-  const double support = settings_.support_radius();
   // A fluid particle that stepped across a plane swaps roles with its image, which stepped
   // the other way: reflect it back (position and normal velocity), as a specular wall would.
   for (const auto& plane : settings_.mirror_planes) {
@@ -115,6 +157,16 @@ void FluidSolver<D>::refresh_mirror_images() {
       }
     }
   }
+}
+
+template <int D>
+void FluidSolver<D>::add_mirror_images() {
+  if (settings_.mirror_planes.empty()) return;
+  auto& p = particles_;
+  // Mirror every fluid and wall particle within a support of a plane: x' = x - 2 d n,
+  // v' = v - 2 (v.n) n.
+  const std::size_t kept = p.size();
+  const double support = settings_.support_radius();
   const auto& lower = settings_.domain_lower;
   const auto& upper = settings_.domain_upper;
   for (const auto& plane : settings_.mirror_planes) {
@@ -205,6 +257,8 @@ void FluidSolver<D>::save_checkpoint() {
   c.lost_density = lost_density_;
   c.max_speed = max_speed_;
   c.max_acceleration = max_acceleration_;
+  c.owned_begin = owned_begin_;
+  c.owned_end = owned_end_;
   if (surface_) surface_->save_checkpoint();
 }
 
@@ -225,6 +279,8 @@ void FluidSolver<D>::restore_checkpoint() {
   lost_density_ = c.lost_density;
   max_speed_ = c.max_speed;
   max_acceleration_ = c.max_acceleration;
+  owned_begin_ = c.owned_begin;
+  owned_end_ = c.owned_end;
   if (surface_) surface_->restore_checkpoint();
 }
 
@@ -238,10 +294,13 @@ void FluidSolver<D>::evaluate_rates() {
   update_wall_state<D>(particles_, grid_, settings_, body_acceleration_, filter);
   if (!plates_.empty() || body_forces_requested_ || body_forces_always_) {
     body_forces_.assign(plates_.size() + 1, Vec<D>{});
-    compute_fluid_rates<D>(particles_, grid_, settings_, filter, &body_forces_, body_forces_requested_ || body_forces_always_);
+    compute_fluid_rates<D>(particles_, grid_, settings_, filter, &body_forces_, body_forces_requested_ || body_forces_always_,
+                           owned_begin_, owned_end_);
     body_forces_requested_ = false;
+    // Each rank booked the reactions of its own fluid: the bodies feel the sum.
+    if (slabs_) slabs_->sum(std::span<double>(body_forces_.front().data(), body_forces_.size() * D));
   } else {
-    compute_fluid_rates<D>(particles_, grid_, settings_, filter);
+    compute_fluid_rates<D>(particles_, grid_, settings_, filter, nullptr, false, owned_begin_, owned_end_);
   }
   if (surface_) surface_->add_surface_rates(particles_);
 }
@@ -252,12 +311,13 @@ void FluidSolver<D>::step() {
   const float half = static_cast<float>(0.5 * dt);
   const float full = static_cast<float>(dt);
   auto& p = particles_;
-  auto n = static_cast<std::ptrdiff_t>(p.size());
+  // Split over ranks, only the own particles are integrated (the halo is replaced after the drift).
+  auto first = static_cast<std::ptrdiff_t>(owned_begin_), last = static_cast<std::ptrdiff_t>(owned_end_);
   if (surface_) surface_->begin_step(p);
 
   // First kick (velocity half step, density predicted to the full step) and drift (eq. 4).
 #pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
+  for (std::ptrdiff_t i = first; i < last; ++i) {
     if (p.kind[i] != Kind::fluid) continue;
     for (int d = 0; d < D; ++d) {
       p.velocity[d][i] += half * p.acceleration[d][i];
@@ -273,7 +333,7 @@ void FluidSolver<D>::step() {
   }
   if (!plates_.empty()) {
 #pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t i = 0; i < n; ++i) {
+    for (std::ptrdiff_t i = first; i < last; ++i) {
       if (p.kind[i] != Kind::wall || p.body[i] == 0) continue;
       const auto& plate = plates_[p.body[i] - 1];
       for (int d = 0; d < D; ++d) {
@@ -287,11 +347,23 @@ void FluidSolver<D>::step() {
     surface_->move_to(time_);
     surface_->correct_crossings(p);
   }
-  refresh_mirror_images();
-  n = static_cast<std::ptrdiff_t>(p.size());  // the mirror images changed the count
-
-  lost_ += grid_.wrap_and_mark_lost(p);
+  if (slabs_) {
+    // Own particles only, then migration to the neighbours and their fresh halo copies; the
+    // images are made from both.
+    slabs_->drop_halo(p, owned_begin_, owned_end_);
+    drop_mirror_images_and_reflect();
+    const double newly_lost = static_cast<double>(grid_.wrap_and_mark_lost(p));
+    slabs_->migrate_and_share_halo(p);
+    add_mirror_images();
+    lost_ += static_cast<std::size_t>(slabs_->sum(newly_lost));
+  } else {
+    refresh_mirror_images();
+    lost_ += grid_.wrap_and_mark_lost(p);
+  }
   grid_.sort(p);
+  update_owned_range();  // the mirror images and the exchange changed the count
+  first = static_cast<std::ptrdiff_t>(owned_begin_);
+  last = static_cast<std::ptrdiff_t>(owned_end_);
   if (surface_) classify_surface();
   evaluate_rates();
   if (surface_) {
@@ -316,7 +388,7 @@ void FluidSolver<D>::step() {
   const float density_limit = static_cast<float>(settings_.max_density_deviation * settings_.rest_density);
   std::size_t out_of_range = 0;
 #pragma omp parallel for schedule(static) reduction(max : max_speed2, max_acc2) reduction(+ : out_of_range)
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
+  for (std::ptrdiff_t i = first; i < last; ++i) {
     if (p.kind[i] != Kind::fluid) continue;
     // Like DualSPHysics' RhopOut: a particle whose density leaves the band (a splash droplet
     // expanding without neighbours) is taken out rather than allowed to blow up the step.
@@ -335,6 +407,11 @@ void FluidSolver<D>::step() {
     max_speed2 = std::max(max_speed2, v2);
     max_acc2 = std::max(max_acc2, a2);
   }
+  if (slabs_) {
+    max_speed2 = static_cast<float>(slabs_->max(max_speed2));
+    max_acc2 = static_cast<float>(slabs_->max(max_acc2));
+    out_of_range = static_cast<std::size_t>(slabs_->sum(static_cast<double>(out_of_range)));
+  }
   max_speed_ = std::sqrt(max_speed2);
   max_acceleration_ = std::sqrt(max_acc2);
   lost_ += out_of_range;
@@ -350,7 +427,7 @@ void FluidSolver<D>::shift_particles(double dt) {
   const auto& s = settings_;
   const double scale = s.shifting * s.smoothing_length() * max_speed_ * dt;
   const double cap = s.max_shift_fraction * s.particle_spacing;
-  const auto n = static_cast<std::ptrdiff_t>(p.size());
+  const auto first = static_cast<std::ptrdiff_t>(owned_begin_), n = static_cast<std::ptrdiff_t>(owned_end_);
   const bool with_surface = surface_ != nullptr && near_surface_.size() == p.size();
   auto shift_of = [&](std::ptrdiff_t i) {
     Vec<D> shift{};
@@ -364,7 +441,7 @@ void FluidSolver<D>::shift_particles(double dt) {
     return shift;
   };
 #pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
+  for (std::ptrdiff_t i = first; i < n; ++i) {
     if (p.kind[i] != Kind::fluid || p.kernel_sum[i] < s.free_surface_kernel_sum) continue;
     if (with_surface && near_surface_[static_cast<std::size_t>(i)]) continue;  // asked below
     const Vec<D> shift = shift_of(i);
@@ -373,7 +450,7 @@ void FluidSolver<D>::shift_particles(double dt) {
   if (!with_surface) return;
   // Near the surface the model decides (a shift must not carry a particle across it); the
   // model keeps counters, so these calls stay on one thread.
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
+  for (std::ptrdiff_t i = first; i < n; ++i) {
     if (!near_surface_[static_cast<std::size_t>(i)] || p.kind[i] != Kind::fluid ||
         p.kernel_sum[i] < s.free_surface_kernel_sum)
       continue;
@@ -389,7 +466,7 @@ void FluidSolver<D>::choose_time_step() {
   const double h = s.smoothing_length();
   if (steps_ == 0) {
     float a2 = 0.0f;
-    for (std::size_t i = 0; i < particles_.size(); ++i) {
+    for (std::size_t i = owned_begin_; i < owned_end_; ++i) {
       if (particles_.kind[i] != Kind::fluid) continue;
       float v2 = 0.0f, acc2 = 0.0f;
       for (int d = 0; d < D; ++d) {
@@ -400,6 +477,10 @@ void FluidSolver<D>::choose_time_step() {
       a2 = std::max(a2, acc2);
     }
     max_acceleration_ = std::sqrt(a2);
+    if (slabs_) {
+      max_speed_ = static_cast<float>(slabs_->max(max_speed_));
+      max_acceleration_ = static_cast<float>(slabs_->max(max_acceleration_));
+    }
   }
   // The surface's nodes count as fluid speed: a moving leaflet must not outrun the step.
   const double speed = std::max<double>(max_speed_, surface_ ? surface_->max_node_speed() : 0.0);

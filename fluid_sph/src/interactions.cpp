@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "valvefsi/fluid/equation_of_state.hpp"
 #include "valvefsi/fluid/kernels.hpp"
@@ -518,7 +520,8 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
 
 template <int D>
 void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSettings<D>& s, const PairFilter<D>& filter,
-                         std::vector<Vec<D>>* body_forces, bool include_fixed_walls) {
+                         std::vector<Vec<D>>* body_forces, bool include_fixed_walls, std::size_t lane_begin,
+                         std::size_t lane_end) {
   const PairConstants<D> k(s);
   const ParticleView<D> view(p);
   const bool shifting = s.shifting > 0;
@@ -529,6 +532,9 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
   const int body_count = body_forces != nullptr ? static_cast<int>(body_forces->size()) : 0;
   if (body_count > kMaxBookedBodies) {
     // Too many bodies to book in the pair loop: the separate pass over the wall particles.
+    if (lane_begin != 0 || lane_end < p.size())
+      throw std::invalid_argument("compute_fluid_rates: more than " + std::to_string(kMaxBookedBodies) +
+                                  " bodies are not supported in a run split over MPI ranks");
     compute_fluid_rates<D>(p, grid, s, filter);
     *body_forces = compute_body_forces<D>(p, grid, s, static_cast<std::size_t>(body_count), include_fixed_walls, filter);
     return;
@@ -545,7 +551,8 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
       booking.thread_forces = per_thread.data() + static_cast<std::size_t>(omp_get_thread_num()) * static_cast<std::size_t>(std::max(body_count, 1)) * D;
       // Rates are needed for the fluid; booked reactions also where mirror fluid meets a wall.
       auto wanted = [&](std::uint32_t a) {
-        return p.kind[a] == Kind::fluid || (body_count > 0 && p.kind[a] == Kind::mirror_fluid && p.near_wall[a] != 0);
+        return a >= lane_begin && a < lane_end &&
+               (p.kind[a] == Kind::fluid || (body_count > 0 && p.kind[a] == Kind::mirror_fluid && p.near_wall[a] != 0));
       };
       for_each_lane_block<D, kBlock>(grid, wanted, [&](const std::uint32_t* lane_index, int n, const auto& segments, int count) {
         const bool masked = filter.touches(segments, count);
@@ -608,8 +615,8 @@ template void update_fluid_pressure<2>(Particles<2>&, const FluidSettings<2>&);
 template void update_fluid_pressure<3>(Particles<3>&, const FluidSettings<3>&);
 template void update_wall_state<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, const std::vector<Vec<2>>&, const PairFilter<2>&);
 template void update_wall_state<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, const std::vector<Vec<3>>&, const PairFilter<3>&);
-template void compute_fluid_rates<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, const PairFilter<2>&, std::vector<Vec<2>>*, bool);
-template void compute_fluid_rates<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, const PairFilter<3>&, std::vector<Vec<3>>*, bool);
+template void compute_fluid_rates<2>(Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, const PairFilter<2>&, std::vector<Vec<2>>*, bool, std::size_t, std::size_t);
+template void compute_fluid_rates<3>(Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, const PairFilter<3>&, std::vector<Vec<3>>*, bool, std::size_t, std::size_t);
 template std::vector<Vec<2>> compute_body_forces<2>(const Particles<2>&, const CellGrid<2>&, const FluidSettings<2>&, std::size_t, bool, const PairFilter<2>&);
 template std::vector<Vec<3>> compute_body_forces<3>(const Particles<3>&, const CellGrid<3>&, const FluidSettings<3>&, std::size_t, bool, const PairFilter<3>&);
 

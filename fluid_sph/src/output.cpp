@@ -36,7 +36,8 @@ void write_dataset(hid_t location, const std::string& name, const T* data, hsize
 }  // namespace
 
 template <int D>
-SnapshotWriter<D>::SnapshotWriter(const std::filesystem::path& directory) : directory_(directory) {
+SnapshotWriter<D>::SnapshotWriter(const std::filesystem::path& directory, bool writes) : directory_(directory), writes_(writes) {
+  if (!writes_) return;
   std::filesystem::create_directories(directory_);
   const auto file = directory_ / "fluid_particles.h5";
   const hid_t h = check_id(H5Fcreate(file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), "create " + file.string());
@@ -46,17 +47,24 @@ SnapshotWriter<D>::SnapshotWriter(const std::filesystem::path& directory) : dire
 template <int D>
 void SnapshotWriter<D>::write(const FluidSolver<D>& solver) {
   const auto& p = solver.particles();
-  // Mirror images are scratch of the symmetry planes, rebuilt every step: not written.
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) n += !is_mirror(p.kind[i]);
+  // Mirror images are scratch of the symmetry planes, rebuilt every step: not written; nor the
+  // halo of a split run (the neighbour writes its own particles).
+  const auto* slabs = solver.decomposition();
+  std::vector<std::size_t> written;
+  const auto [first, last] = solver.owned_range();
+  for (std::size_t i = first; i < last; ++i)
+    if (!is_mirror(p.kind[i])) written.push_back(i);
+  if (slabs != nullptr)
+    for (std::size_t i = solver.grid().cell_start(solver.grid().cell_count()); i < p.size(); ++i)
+      if (p.kind[i] == Kind::lost) written.push_back(i);
+  std::size_t n = written.size();
   std::vector<double> position(3 * n, 0.0), velocity(3 * n, 0.0);
   std::vector<float> pressure(n), density(n);
   std::vector<int> kind(n);
   std::vector<unsigned> id(n);
   const double background = solver.settings().background_pressure;
   std::size_t j = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (is_mirror(p.kind[i])) continue;
+  for (const std::size_t i : written) {
     for (int d = 0; d < D; ++d) {
       position[3 * j + d] = p.position[d][i];
       velocity[3 * j + d] = p.velocity[d][i];
@@ -67,6 +75,22 @@ void SnapshotWriter<D>::write(const FluidSolver<D>& solver) {
     id[j] = p.id[i];
     ++j;
   }
+  if (slabs != nullptr) {
+    // Rank 0 writes everyone's particles, in rank order.
+    auto gather = [&]<class T>(std::vector<T>& values) {
+      const std::vector<double> mine(values.begin(), values.end());
+      const std::vector<double> all = slabs->gather(mine);
+      values.assign(all.begin(), all.end());
+    };
+    gather(position);
+    gather(velocity);
+    gather(pressure);
+    gather(density);
+    gather(kind);
+    gather(id);
+    n = pressure.size();
+  }
+  if (!writes_) return;
   const auto file = directory_ / "fluid_particles.h5";
   const hid_t h = check_id(H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), "open " + file.string());
   const std::string group = fmt::format("snapshot_{:06d}", entries_.size());

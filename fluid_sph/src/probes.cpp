@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "valvefsi/fluid/kernels.hpp"
 
@@ -26,16 +27,25 @@ bool in_slab(const Particles<D>& p, std::size_t i, const ProbePlane<D>& plane, d
   return r2 <= plane.radius * plane.radius;
 }
 
+// Over ranks: the sum of the values (unchanged on one rank).
+template <int D>
+void sum_over_ranks(const FluidSolver<D>& solver, std::span<double> values) {
+  if (solver.decomposition() != nullptr) solver.decomposition()->sum(values);
+}
+
 }  // namespace
 
+// Every probe reads this rank's own particles and combines the ranks' parts (collective when
+// the run is split over MPI ranks: every rank must call it).
 template <int D>
 double pressure_at(const FluidSolver<D>& solver, const Vec<D>& x) {
   const auto& p = solver.particles();
   const auto& s = solver.settings();
   const double support = s.support_radius();
   return with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
-    double sum_w = 0, sum_p = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
+    const auto [first, last] = solver.owned_range();
+    double sums[2] = {0, 0};  // sum W, sum p W
+    for (std::size_t i = first; i < last; ++i) {
       if (p.kind[i] != Kind::fluid) continue;
       double r2 = 0;
       for (int d = 0; d < D; ++d) {
@@ -48,10 +58,11 @@ double pressure_at(const FluidSolver<D>& solver, const Vec<D>& x) {
       }
       if (r2 >= support * support) continue;
       const double w = W.value(static_cast<float>(std::sqrt(r2)));
-      sum_w += w;
-      sum_p += w * p.pressure[i];
+      sums[0] += w;
+      sums[1] += w * p.pressure[i];
     }
-    return sum_w > 0 ? sum_p / sum_w - s.background_pressure : 0.0;
+    sum_over_ranks<D>(solver, sums);
+    return sums[0] > 0 ? sums[1] / sums[0] - s.background_pressure : 0.0;
   });
 }
 
@@ -61,13 +72,15 @@ double flow_rate(const FluidSolver<D>& solver, const ProbePlane<D>& plane) {
   const auto& s = solver.settings();
   const double dp = s.particle_spacing;
   double q = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
+  const auto [first, last] = solver.owned_range();
+  for (std::size_t i = first; i < last; ++i) {
     if (p.kind[i] != Kind::fluid || !in_slab<D>(p, i, plane, 0.5 * dp)) continue;
     double vn = 0;
     for (int d = 0; d < D; ++d) vn += p.velocity[d][i] * plane.normal[d];
     const double volume = s.particle_mass() / (s.rest_density + p.density_excess[i]);
     q += vn * volume / dp;
   }
+  sum_over_ranks<D>(solver, std::span<double>(&q, 1));
   return q;
 }
 
@@ -75,13 +88,14 @@ template <int D>
 double max_speed_on_plane(const FluidSolver<D>& solver, const ProbePlane<D>& plane) {
   const auto& p = solver.particles();
   double best = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
+  const auto [first, last] = solver.owned_range();
+  for (std::size_t i = first; i < last; ++i) {
     if (p.kind[i] != Kind::fluid || !in_slab<D>(p, i, plane, 0.5 * solver.settings().particle_spacing)) continue;
     double v2 = 0;
     for (int d = 0; d < D; ++d) v2 += static_cast<double>(p.velocity[d][i]) * p.velocity[d][i];
     best = std::max(best, std::sqrt(v2));
   }
-  return best;
+  return solver.decomposition() != nullptr ? solver.decomposition()->max(best) : best;
 }
 
 template <int D>
@@ -89,10 +103,12 @@ double kinetic_energy(const FluidSolver<D>& solver) {
   const auto& p = solver.particles();
   const double m = solver.settings().particle_mass();
   double e = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
+  const auto [first, last] = solver.owned_range();
+  for (std::size_t i = first; i < last; ++i) {
     if (p.kind[i] != Kind::fluid) continue;
     for (int d = 0; d < D; ++d) e += 0.5 * m * static_cast<double>(p.velocity[d][i]) * p.velocity[d][i];
   }
+  sum_over_ranks<D>(solver, std::span<double>(&e, 1));
   return e;
 }
 

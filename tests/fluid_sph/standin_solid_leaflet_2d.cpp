@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "standin_common.hpp"
+#include "valvefsi/coupling/restart_file.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"2D stand-in solid: one straight rigid leaflet, still or oscillating along x"};
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
     auto options = valvefsi::standins::participant_options(common, valvefsi::coupling::ParticipantRole::solid,
                                                            "standin_solid_leaflet_2d");
     options.spatial_dimension = 2;
+    options.can_restart = true;  // its state: the running sums of the mean force
     participant = std::make_unique<valvefsi::coupling::Participant>(options);
     valvefsi::coupling::InterfaceSurfaceData surface;
     surface.nodes_per_cell = 2;
@@ -57,7 +59,20 @@ int main(int argc, char** argv) {
     participant->initialize_solid(surface, motion_at(0.0));
     valvefsi::coupling::Window window;
     double sum_x = 0, sum_y = 0, sum_t = 0;
+    if (const auto& folder = participant->session().restart_directory; !folder.empty()) {
+      const valvefsi::coupling::RestartReader file(valvefsi::coupling::restart_file_path(folder, participant->name()));
+      sum_x = file.scalar("sum_x");
+      sum_y = file.scalar("sum_y");
+      sum_t = file.scalar("sum_t");
+    }
     while (participant->next_window(window)) {
+      if (window.write_restart) {
+        valvefsi::coupling::RestartWriter file(valvefsi::coupling::restart_file_path(window.restart_directory, participant->name()));
+        file.put("sum_x", sum_x);
+        file.put("sum_y", sum_y);
+        file.put("sum_t", sum_t);
+        file.commit();
+      }
       valvefsi::standins::simulate_step(common, window.index);
       if (window.end() > average_from) {
         sum_x += window.size * window.loads.forces.row(0).sum();

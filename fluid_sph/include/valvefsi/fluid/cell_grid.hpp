@@ -45,6 +45,11 @@ class CellGrid {
 
   std::size_t cell_of(const Particles<D>& particles, std::size_t i) const;
 
+  // The cell ranges of the last sort (cell_count() + 2 entries), for restart files; the
+  // setter throws std::invalid_argument on a wrong size.
+  const std::vector<std::uint32_t>& cell_starts() const { return start_; }
+  void set_cell_starts(std::vector<std::uint32_t> starts);
+
   // Up to 3^(D-1) * 3 segments covering the cell's neighbour cells; returns how many.
   int neighbour_segments(std::size_t cell, std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& out) const {
     return neighbour_segments(cell, cell, out);

@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <span>
 #include <vector>
 
 #include "valvefsi/fluid/cell_grid.hpp"
@@ -13,6 +15,7 @@
 #include "valvefsi/fluid/pair_filter.hpp"
 #include "valvefsi/fluid/particles.hpp"
 #include "valvefsi/fluid/pressure_plate.hpp"
+#include "valvefsi/fluid/slab_decomposition.hpp"
 
 namespace valvefsi::fluid {
 
@@ -38,6 +41,30 @@ class FluidSolver {
   void save_checkpoint();
   void restore_checkpoint();
   bool has_checkpoint() const { return checkpoint_ != nullptr; }
+
+  // Restart files (docs/coupling.md, "Restarts"): the whole state as named arrays, such that
+  // load_restart_state on a solver built from the same case (and, with a surface, the same
+  // surface geometry already installed) continues bit for bit. The particles keep their order
+  // with every field and scratch array a step reads, the cell ranges of the last sort, plates,
+  // time, dt, step count, lost counters, the window's surface-force sums, and the surface
+  // model's own restart_state() under the prefix "surface/". std::nullopt when the surface
+  // model cannot restart (the solver then cannot either).
+  std::optional<std::vector<NamedArray>> restart_state() const;
+  // Throws std::runtime_error naming the array that is missing or of the wrong size.
+  void load_restart_state(std::span<const NamedArray> arrays);
+
+  // Splits the run over the ranks of `comm` (collective; right after construction, before the
+  // first step): slabs of cell layers along the last axis (SlabDecomposition). With one rank
+  // nothing changes. Throws std::invalid_argument for what it cannot split: an immersed
+  // surface, a mirror plane whose normal has a component along the slab axis, a periodic slab
+  // axis, more ranks than the layers allow.
+  void decompose(MPI_Comm comm);
+  // nullptr when the run is not split.
+  const SlabDecomposition<D>* decomposition() const { return slabs_.get(); }
+  // This rank's own particles (sorted indices [first, second)); all particles on one rank.
+  // The rest of particles() is halo (copies of the neighbours' particles), mirror images and,
+  // split, the lost particles at the end.
+  std::pair<std::size_t, std::size_t> owned_range() const { return {owned_begin_, owned_end_}; }
 
   // Advances by time_step() and then chooses the next time step.
   void step();
@@ -68,6 +95,9 @@ class FluidSolver {
   void shift_particles(double dt);
   void classify_surface();
   void refresh_mirror_images();
+  void drop_mirror_images_and_reflect();
+  void add_mirror_images();
+  void update_owned_range();
   PairFilter<D> pair_filter() const;
 
   struct Checkpoint;
@@ -94,6 +124,8 @@ class FluidSolver {
   double surface_force_time_ = 0.0;
   std::vector<Vec<D>> surface_force_scratch_;
   std::shared_ptr<Checkpoint> checkpoint_;
+  std::unique_ptr<SlabDecomposition<D>> slabs_;
+  std::size_t owned_begin_ = 0, owned_end_ = 0;
 };
 
 }  // namespace valvefsi::fluid

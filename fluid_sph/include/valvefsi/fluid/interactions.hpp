@@ -30,10 +30,13 @@ void update_wall_state(Particles<D>& particles, const CellGrid<D>& grid, const F
 // fluid on each body 0..size-1, the fixed walls (body 0) only if include_fixed_walls: booked
 // in the same pair loop as the reaction of the fluid-wall pair terms (they are
 // antisymmetric), so no second pass over the walls; equal to compute_body_forces to round-off.
+// Rates are computed (and reactions booked) only for the particles with sorted index in
+// [lane_begin, lane_end): a rank's own particles when the run is split over MPI ranks.
 template <int D>
 void compute_fluid_rates(Particles<D>& particles, const CellGrid<D>& grid, const FluidSettings<D>& settings,
                          const PairFilter<D>& filter = {}, std::vector<Vec<D>>* body_forces = nullptr,
-                         bool include_fixed_walls = false);
+                         bool include_fixed_walls = false, std::size_t lane_begin = 0,
+                         std::size_t lane_end = static_cast<std::size_t>(-1));
 
 // The same forces by a pass of its own over the wall particles (the reference the booked
 // forces are tested against; used when there are too many bodies to book).

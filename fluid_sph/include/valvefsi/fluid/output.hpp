@@ -15,7 +15,9 @@ namespace valvefsi::fluid {
 template <int D>
 class SnapshotWriter {
  public:
-  explicit SnapshotWriter(const std::filesystem::path& directory);
+  // `writes`: false on the ranks other than 0 of a run split over MPI ranks (they only send).
+  explicit SnapshotWriter(const std::filesystem::path& directory, bool writes = true);
+  // Collective when the run is split: the ranks' own (and lost) particles are gathered on rank 0.
   void write(const FluidSolver<D>& solver);
   std::size_t count() const { return entries_.size(); }
 
@@ -26,6 +28,7 @@ class SnapshotWriter {
   };
   void write_xdmf() const;
   std::filesystem::path directory_;
+  bool writes_ = true;
   std::vector<Entry> entries_;
 };
 

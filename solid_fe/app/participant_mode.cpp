@@ -4,6 +4,7 @@
 // waveform is not applied: the fluid carries the load.
 #include "participant_mode.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -11,14 +12,17 @@
 #include <string>
 
 #include <omp.h>
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "valvefsi/coupling/endpoint.hpp"
 #include "valvefsi/coupling/participant.hpp"
+#include "valvefsi/coupling/restart_file.hpp"
 #include "valvefsi/solid/case_setup.hpp"
 #include "valvefsi/solid/material_error.hpp"
 #include "valvefsi/solid/solid_interface.hpp"
 #include "valvefsi/solid/solid_output.hpp"
+#include "valvefsi/solid/solver_restart.hpp"
 
 namespace valvefsi::solid {
 namespace {
@@ -30,8 +34,9 @@ constexpr int kExitSolidFailure = 6;  // the solid's own failure (material state
 // next one does not restore it, so the state is written when the following window opens.
 class CoupledOutput {
  public:
-  CoupledOutput(const cases::Case& c, const std::filesystem::path& dir, const SolidSetup& setup)
-      : fields_(dir, setup.mesh, setup.element_family), series_(dir, monitors_of(setup)),
+  CoupledOutput(const cases::Case& c, const std::filesystem::path& dir, const SolidSetup& setup,
+                const std::string& suffix)
+      : fields_(dir, setup.mesh, setup.element_family, suffix), series_(dir, monitors_of(setup), suffix),
         snapshot_interval_(c.run().snapshot_interval()), series_interval_(c.run().series_interval()) {}
 
   void accepted(const ExplicitSolver& solver, bool last) {
@@ -95,18 +100,33 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
   options.endpoint = coupling::resolve_endpoint(c.coupling().endpoint(), output_dir);
   options.spatial_dimension = setup.dimension;
   options.can_checkpoint = true;
+  options.can_restart = true;  // solver_restart.hpp: the whole SolverState
   options.liveness.heartbeat_interval = std::chrono::duration<double>(c.coupling().heartbeat_interval_s());
   options.liveness.peer_timeout = std::chrono::duration<double>(c.coupling().peer_timeout_s());
   options.liveness.startup_timeout = std::chrono::duration<double>(c.coupling().startup_timeout_s());
 
   std::unique_ptr<coupling::Participant> participant;
   try {
-    CoupledOutput output(c, output_dir, setup);
     participant = std::make_unique<coupling::Participant>(options);
     solver.advance_window(0.0);  // forces and stable step of the initial state
     coupling::InterfaceMotion motion;
     interface.motion(solver.state(), motion.positions, motion.velocities);
     participant->initialize_solid(surface_data(interface), motion);
+    std::string output_suffix;
+    if (const auto& folder = participant->session().restart_directory; !folder.empty()) {
+      const auto file = coupling::restart_file_path(folder, participant->name());
+      read_solver_restart(file, solver);
+      const double t = participant->session().restart_time;
+      if (std::abs(solver.state().time - t) > 1e-9 * std::max(1.0, std::abs(t))) {
+        throw std::runtime_error(fmt::format("{}: the solid's state is at t = {} s, the coupler restarts at {} s",
+                                             file.string(), solver.state().time, t));
+      }
+      output_suffix = restarted_output_suffix(output_dir, t);
+      spdlog::info("continuing from {} (t = {} s, step {}); output {}", file.string(), solver.state().time,
+                   solver.state().step, output_suffix.empty() ? "files start at the restart time"
+                                                              : "files named with suffix " + output_suffix);
+    }
+    CoupledOutput output(c, output_dir, setup, output_suffix);
     spdlog::info("coupled ({}D, {} interface nodes, {} cells) with {} {}, scheme {}; {} threads; output to {}",
                  setup.dimension, interface.nodes.size(), interface.cells.cols(),
                  participant->session().partner_solver_name, participant->session().partner_solver_version,
@@ -127,6 +147,9 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
         output.accepted(solver, false);
       }
       if (window.save_checkpoint) checkpoint = solver.state();
+      if (window.write_restart) {
+        write_solver_restart(solver, coupling::restart_file_path(window.restart_directory, participant->name()));
+      }
       interface.nodal_forces(window.loads.forces, setup.mesh.num_nodes(), nodal_forces);
       solver.advance_window(window.end(), &nodal_forces);
       have_unwritten_state = true;
@@ -150,6 +173,8 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
                  "energy balance error {:.2e}",
                  s.time, s.step, repeats, wall, 1e3 * wall / std::max<std::int64_t>(s.step, 1),
                  s.energy.relative_balance_error());
+    spdlog::info("coupler loads: work {:.6e} J on the solid (F . dx), {:.6e} J as the coupler books it "
+                 "(F . v(window start) dt)", s.energy.external_work, s.energy.interface_work);
     participant->finalize();
     return 0;
   } catch (const coupling::TransportError& e) {
@@ -160,6 +185,10 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
     spdlog::error("{}", e.what());
     if (participant) participant->abort(std::string("solid_fe: ") + e.what());
     return kExitSolidFailure;
+  } catch (const std::runtime_error& e) {  // e.g. a restart file that does not fit this case
+    spdlog::error("{}", e.what());
+    if (participant) participant->abort(std::string("solid_fe: ") + e.what());
+    return 2;
   }
 }
 

@@ -1,7 +1,7 @@
 // solid_fe: the leaflet finite-element solver. FE-only mode applies the case's uniform
 // transvalvular pressure to the leaflets and runs to run.end_time; otherwise it is the
 // coupler's structure participant (participant_mode.cpp, docs/solid_fe.md).
-//   solid_fe --case cases/<name>.textproto [--fe-only] [--output DIR]
+//   solid_fe --case cases/<name>.textproto [--fe-only] [--output DIR] [--restart DIR]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,17 +17,25 @@
 
 #include "valvefsi/case/case_loader.hpp"
 #include "valvefsi/case/pressure_waveform.hpp"
+#include "valvefsi/coupling/restart_file.hpp"
+#include "valvefsi/coupling/restart_points.hpp"
 #include "valvefsi/solid/case_setup.hpp"
 #include "valvefsi/solid/material_error.hpp"
 #include "valvefsi/solid/solid_output.hpp"
+#include "valvefsi/solid/solver_restart.hpp"
 #include "participant_mode.hpp"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Index of the first multiple of `interval` after t (a restarted run continues the same grid).
+std::int64_t next_multiple(double t, double interval) {
+  return interval > 0 ? static_cast<std::int64_t>(std::floor(t / interval + 1e-9)) + 1 : 1;
+}
+
 int run_fe_only(const valvefsi::cases::Case& c, const std::filesystem::path& case_file,
-                const std::filesystem::path& output_dir) {
+                const std::filesystem::path& output_dir, const std::string& restart) {
   using namespace valvefsi::solid;
   const auto wall_start = Clock::now();
   SolidSetup setup = setup_from_case(c, case_file);
@@ -41,8 +49,17 @@ int run_fe_only(const valvefsi::cases::Case& c, const std::filesystem::path& cas
   const double series_interval = c.run().series_interval();
   std::vector<std::pair<std::string, std::vector<std::int64_t>>> monitors;
   for (const auto& m : setup.monitors) monitors.emplace_back(m.name, m.nodes);
-  FieldWriter fields(output_dir, setup.mesh, setup.element_family);
-  SeriesWriter series(output_dir, monitors);
+  solver.advance_window(0.0);
+  std::string suffix;
+  if (!restart.empty()) {
+    const auto folder = valvefsi::coupling::resolve_restart_folder(restart, {"solid"});
+    read_solver_restart(valvefsi::coupling::restart_file_path(folder, "solid"), solver);
+    suffix = restarted_output_suffix(output_dir, solver.state().time);
+    spdlog::info("continuing from {} (t = {} s, step {}); output {}", folder.string(), solver.state().time,
+                 solver.state().step, suffix.empty() ? "files start at the restart time" : "files named with suffix " + suffix);
+  }
+  FieldWriter fields(output_dir, setup.mesh, setup.element_family, suffix);
+  SeriesWriter series(output_dir, monitors, suffix);
   spdlog::info("FE-only: {} s of the waveform on {} threads, output to {}", end_time, omp_get_max_threads(),
                output_dir.string());
 
@@ -53,10 +70,12 @@ int run_fe_only(const valvefsi::cases::Case& c, const std::filesystem::path& cas
   };
   const auto sample = [&] { series.sample(solver, waveform.transvalvular_pressure(solver.state().time)); };
 
-  // Output times are the windows the solver advances over.
-  std::int64_t next_snapshot = 1, next_sample = 1;
+  // Output times and restart points are the windows the solver advances over.
+  const double restart_interval = c.solid().restart_interval_s();
+  const double t0 = solver.state().time;
+  std::int64_t next_snapshot = next_multiple(t0, snapshot_interval), next_sample = next_multiple(t0, series_interval);
+  std::int64_t next_restart = next_multiple(t0, restart_interval);
   const auto time_of = [](std::int64_t k, double interval) { return interval > 0 ? k * interval : HUGE_VAL; };
-  solver.advance_window(0.0);
   if (snapshot_interval > 0) snapshot();
   sample();
   auto last_progress = Clock::now();
@@ -66,9 +85,17 @@ int run_fe_only(const valvefsi::cases::Case& c, const std::filesystem::path& cas
     while (solver.state().time < end_time) {
       const double t_snap = time_of(next_snapshot, snapshot_interval);
       const double t_sample = series_interval > 0 ? time_of(next_sample, series_interval) : solver.state().time + 1e-4;
-      const double target = std::min({end_time, t_snap, t_sample});
+      const double t_restart = time_of(next_restart, restart_interval);
+      const double target = std::min({end_time, t_snap, t_sample, t_restart});
       solver.advance_window(target);
       const double t = solver.state().time;
+      if (t >= t_restart - 1e-12) {
+        const auto folder = valvefsi::coupling::restart_folder(output_dir, t);
+        std::filesystem::create_directories(folder);
+        write_solver_restart(solver, valvefsi::coupling::restart_file_path(folder, "solid"));
+        valvefsi::coupling::mark_restart_complete(folder, c.solid().restart_keep());
+        ++next_restart;
+      }
       if (t >= t_sample - 1e-12 || t >= end_time) {
         sample();
         ++next_sample;
@@ -113,13 +140,23 @@ int main(int argc, char** argv) {
   app.add_option("--case", case_path, "case file (protobuf text format, message valvefsi.cases.Case)")->required();
   app.add_flag("--fe-only", fe_only, "run alone under the case's uniform transvalvular pressure (default: coupled participant)");
   app.add_option("--output", output, "output folder (default: the case's run.output_dir)");
+  std::string restart;
+  app.add_option("--restart", restart,
+                 "FE-only: continue from a restart point (a run's restart/ folder: its LATEST; or one t_<time> folder)");
   CLI11_PARSE(app, argc, argv);
   spdlog::set_pattern("[solid] %v");
   try {
     const valvefsi::cases::Case c = valvefsi::load_case(case_path);
     const std::filesystem::path output_dir = std::filesystem::path(output.empty() ? c.run().output_dir() : output);
-    if (!fe_only && !c.run().fe_only()) return valvefsi::solid::run_participant(c, case_path, output_dir);
-    return run_fe_only(c, case_path, output_dir);
+    if (!fe_only && !c.run().fe_only()) {
+      if (!restart.empty()) {
+        spdlog::error("--restart {}: coupled runs restart through the coupler (run_case.py --restart), not solid_fe",
+                      restart);
+        return 2;
+      }
+      return valvefsi::solid::run_participant(c, case_path, output_dir);
+    }
+    return run_fe_only(c, case_path, output_dir, restart);
   } catch (const valvefsi::CaseError& e) {
     spdlog::error("{}", e.what());
     return 2;

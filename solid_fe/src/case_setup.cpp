@@ -253,6 +253,42 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
                                       front.size(), setup.strip_depth));
     setup.solver->set_strip_ties(setup.strip_ties);
   }
+  if (solid.has_coaptation_tie()) {
+    const auto& tie_case = solid.coaptation_tie();
+    if (setup.dimension != 2 || bricks) {
+      throw CaseError(fmt::format("{}: field 'solid.coaptation_tie': allowed for 2D shell strips only "
+                                  "(run.dimension is {}, solid.element_family {})", source, setup.dimension,
+                                  bricks ? "HEXAHEDRON" : "SHELL"));
+    }
+    const auto plane = mesh.contact_planes.find(tie_case.contact_plane());
+    if (plane == mesh.contact_planes.end()) {
+      std::vector<std::string> names;
+      for (const auto& [name, p] : mesh.contact_planes) names.push_back(name);
+      throw CaseError(fmt::format("{}: field 'solid.coaptation_tie.contact_plane' = \"{}\": {} has no such contact "
+                                  "plane; allowed: [{}]", source, tie_case.contact_plane(), mesh_name,
+                                  fmt::join(names, ", ")));
+    }
+    const std::string set_name = tie_case.node_set().empty() ? "free_edge" : tie_case.node_set();
+    const auto& nodes = node_set(mesh, set_name, "solid.coaptation_tie.node_set", source, mesh_name);
+    CoaptationTie tie;
+    tie.plane = plane->second;
+    tie.release_force = tie_case.release_force_n_per_m() * setup.strip_depth;
+    std::set<std::int64_t> grouped;
+    for (const std::int64_t n : nodes) {
+      if (grouped.count(n) != 0) continue;
+      std::vector<std::int64_t> group{n};
+      for (const auto& t : setup.strip_ties) {
+        if (t.front == n) group.push_back(t.back);
+        if (t.back == n) group.push_back(t.front);
+      }
+      grouped.insert(group.begin(), group.end());
+      tie.groups.push_back(std::move(group));
+    }
+    setup.notes.push_back(fmt::format("coaptation tie: {} tips of node set '{}' on contact plane '{}', release at "
+                                      "{} N/m ({} N per tip)", tie.groups.size(), set_name, plane->first,
+                                      tie_case.release_force_n_per_m(), tie.release_force));
+    setup.solver->set_coaptation_tie(std::move(tie));
+  }
   // Leaflet-leaflet contact between the surfaces named leaflet_0, leaflet_1, ...
   std::vector<int> surface_of_node(static_cast<std::size_t>(mesh.num_nodes()), -1);
   int leaflets = 0;

@@ -14,7 +14,8 @@
 namespace valvefsi::solid {
 double EnergyBalance::relative_balance_error() const {
   const double scale = std::max({std::abs(kinetic), std::abs(internal_work), std::abs(external_work),
-                                 std::abs(damping_work), std::abs(contact_work), std::abs(initial_kinetic),
+                                 std::abs(damping_work), std::abs(contact_work), std::abs(tie_work),
+                                 std::abs(initial_kinetic),
                                  1e-300});
   return std::abs(balance()) / scale;
 }
@@ -94,6 +95,109 @@ void ExplicitSolver::set_strip_ties(std::vector<StripTie> ties) {
   internal_force_current_ = false;
 }
 
+void ExplicitSolver::set_coaptation_tie(CoaptationTie tie) {
+  tie.plane.normal.normalize();
+  std::size_t index = contact_planes_.size();
+  for (std::size_t k = 0; k < contact_planes_.size(); ++k) {
+    if ((contact_planes_[k].point - tie.plane.point).norm() <= 1e-12 * (1.0 + tie.plane.point.norm()) &&
+        (contact_planes_[k].normal - tie.plane.normal).norm() <= 1e-12) {
+      index = k;
+    }
+  }
+  if (index == contact_planes_.size()) {
+    throw std::invalid_argument("solid: coaptation tie: its plane is not one of the solver's contact planes");
+  }
+  if (!(tie.release_force > 0.0)) {
+    throw std::invalid_argument(fmt::format("solid: coaptation tie release force {} N: allowed > 0", tie.release_force));
+  }
+  const Eigen::Index n = elements_->reference_positions().cols();
+  Eigen::Index count = 0;
+  for (const auto& group : tie.groups) {
+    if (group.empty()) throw std::invalid_argument("solid: coaptation tie: an empty node group");
+    for (const std::int64_t node : group) {
+      if (node < 0 || node >= n || elements_->fixed()[static_cast<std::size_t>(node)]) {
+        throw std::invalid_argument(fmt::format(
+            "solid: coaptation tie node {}: allowed a free node of the mesh (0 to {})", node, n - 1));
+      }
+      ++count;
+    }
+  }
+  tie_plane_ = index;
+  state_.tie = CoaptationTieState{};
+  state_.tie.tied.assign(tie.groups.size(), 0);
+  state_.tie.anchor = Eigen::Matrix3Xd::Zero(3, count);
+  state_.tie_force = Eigen::Matrix3Xd::Zero(3, n);
+  tie_held_.assign(static_cast<std::size_t>(n), 0);
+  tie_ = std::move(tie);
+  internal_force_current_ = false;
+}
+
+void ExplicitSolver::update_coaptation_tie(double stiffness_per_mass) {
+  // A group is caught when its mean gap to the plane's contact surface is <= 0 (it touches),
+  // anchored at the touching points, so the spring force equals the plane's penalty force at
+  // that moment; it is released when the summed spring force pulls towards -normal (the tips
+  // try to leave the plane) harder than the release force. One spring per node, the stiffness
+  // of the contact penalty: -k (x - anchor) in every direction.
+  const Plane& plane = contact_planes_[tie_plane_];
+  const Eigen::Matrix3Xd& x = state_.position;
+  const Eigen::VectorXd& mass = elements_->nodal_mass();
+  CoaptationTieState& tie = state_.tie;
+  Eigen::Matrix3Xd& f = state_.tie_force;
+  f.setZero();
+  std::fill(tie_held_.begin(), tie_held_.end(), 0);
+  double stored = 0.0;
+  Eigen::Index column = 0;
+  for (std::size_t g = 0; g < tie_->groups.size(); ++g) {
+    const auto& group = tie_->groups[g];
+    const auto first = column;
+    column += static_cast<Eigen::Index>(group.size());
+    if (tie.tied[g]) {
+      Eigen::Vector3d total = Eigen::Vector3d::Zero();
+      for (std::size_t j = 0; j < group.size(); ++j) {
+        const auto i = group[j];
+        total -= stiffness_per_mass * mass(i) * (x.col(i) - tie.anchor.col(first + static_cast<Eigen::Index>(j)));
+      }
+      if (total.dot(plane.normal) < 0.0) {
+        tie.peak_force = std::max(tie.peak_force, total.norm());
+        if (total.norm() > tie_->release_force) {
+          tie.tied[g] = 0;
+          ++tie.releases;
+        }
+      }
+    } else {
+      double mean_gap = 0.0;
+      for (const auto i : group) mean_gap += (x.col(i) - plane.point).dot(plane.normal) - half_thickness_(i);
+      if (mean_gap <= 0.0) {
+        tie.tied[g] = 1;
+        ++tie.captures;
+        for (std::size_t j = 0; j < group.size(); ++j) {
+          const auto i = group[j];
+          const double gap = (x.col(i) - plane.point).dot(plane.normal) - half_thickness_(i);
+          tie.anchor.col(first + static_cast<Eigen::Index>(j)) = x.col(i) - gap * plane.normal;
+        }
+      }
+    }
+    if (!tie.tied[g]) continue;
+    for (std::size_t j = 0; j < group.size(); ++j) {
+      const auto i = group[j];
+      const Eigen::Vector3d stretch = x.col(i) - tie.anchor.col(first + static_cast<Eigen::Index>(j));
+      const double k = stiffness_per_mass * mass(i);
+      f.col(i) -= k * stretch;
+      stored += 0.5 * k * stretch.squaredNorm();
+      tie_held_[static_cast<std::size_t>(i)] = 1;
+    }
+  }
+  state_.energy.tie_energy = stored;
+}
+
+void ExplicitSolver::compute_acceleration(const Eigen::ArrayXd& inverse_mass) {
+  Eigen::Matrix3Xd& a = acceleration_;
+  a = state_.external_force + state_.contact_force - state_.internal_force;
+  if (tie_) a += state_.tie_force;
+  a.array().rowwise() *= inverse_mass.transpose();
+  apply_constraints(a);
+}
+
 void ExplicitSolver::compute_contact_force() {
   Eigen::Matrix3Xd& f = state_.contact_force;
   f.setZero();
@@ -101,17 +205,21 @@ void ExplicitSolver::compute_contact_force() {
   if (!has_contact()) return;
   // Penalty stiffness from the highest frequency the first step resolves, k = factor m (2/dt)^2,
   // then kept: a constant spring is conservative, and the step only shrinks as tissue stiffens.
-  if (contact_omega2_ == 0.0) {
+  if (state_.contact_omega2 == 0.0) {
     const double dt_critical =
         state_.stable_step / (step_factor_ > 0.0 ? step_factor_ : options_.time_step_safety);
-    contact_omega2_ = 4.0 / (dt_critical * dt_critical);
+    state_.contact_omega2 = 4.0 / (dt_critical * dt_critical);
   }
-  const double omega2 = contact_omega2_;
+  const double omega2 = state_.contact_omega2;
   const Eigen::Matrix3Xd& x = state_.position;
   const auto& fixed = elements_->fixed();
   const Eigen::VectorXd& mass = elements_->nodal_mass();
-  for (const Plane& plane : contact_planes_) {
+  if (tie_) update_coaptation_tie(options_.contact_stiffness_factor * omega2);
+  for (std::size_t p = 0; p < contact_planes_.size(); ++p) {
+    const Plane& plane = contact_planes_[p];
+    const bool tie_plane = tie_ && p == tie_plane_;
     for (Eigen::Index i = 0; i < x.cols(); ++i) {
+      if (tie_plane && tie_held_[static_cast<std::size_t>(i)]) continue;  // the tie holds it both ways
       const double gap = (x.col(i) - plane.point).dot(plane.normal) - half_thickness_(i);
       if (gap < 0.0 && !fixed[static_cast<std::size_t>(i)]) {
         f.col(i) -= options_.contact_stiffness_factor * mass(i) * omega2 * gap * plane.normal;
@@ -134,7 +242,8 @@ void ExplicitSolver::compute_contact_force() {
   }
   if (leaflet_contact_) {
     state_.nodes_in_contact +=
-        leaflet_contact_->add_forces(*elements_->contact_surface(), x, options_.contact_stiffness_factor * omega2, f);
+        leaflet_contact_->add_forces(*elements_->contact_surface(), x, options_.contact_stiffness_factor * omega2, f,
+                                     state_.contact_candidates);
   }
 }
 
@@ -345,12 +454,20 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
   Eigen::Matrix3Xd& x = state_.position;
   Eigen::Matrix3Xd& v_half = state_.half_step_velocity;
   Eigen::Matrix3Xd& a = acceleration_;
+  if (nodal_forces != nullptr && t_end > state_.time) {
+    // The coupler's book of this window's load work: the load times the velocity sent at the
+    // window's start, over the window (coupling_schemes.cpp, power_solid).
+    state_.energy.interface_work += nodal_forces->cwiseProduct(state_.velocity).sum() * (t_end - state_.time);
+  }
+  // A coupled window's load starts at its start: the previous load acted over the half step
+  // before it (the end-of-window velocity already holds that half kick), this one over the half
+  // step after it (kick-drift-kick across the load's jump). Kicking the whole averaged step
+  // with the new load missed 1/2 dt dF . v in the energy ledger at every window boundary.
+  bool window_boundary = nodal_forces != nullptr && state_.step > 0;
 
   while (state_.time < t_end) {
     compute_external_force(state_.time, nodal_forces);
-    a = (state_.external_force + state_.contact_force - state_.internal_force).array().rowwise() *
-        inverse_mass.transpose();
-    apply_constraints(a);
+    compute_acceleration(inverse_mass);
 
     // A penalty spring of k = factor m omega^2 raises the node's frequency by sqrt(1 + factor).
     double dt = !has_contact() ? state_.stable_step
@@ -373,11 +490,19 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
       // Central difference with damping force alpha m v at the full step, v the mean of the
       // two half-step velocities (implicit in v).
       previous_half_velocity_ = v_half;
-      v_half = ((1.0 - 0.5 * alpha * averaged_step) * v_half + averaged_step * a) /
-               (1.0 + 0.5 * alpha * averaged_step);
+      if (window_boundary) {
+        v_half = ((1.0 - 0.5 * alpha * averaged_step) * v_half + (state_.velocity - v_half) + 0.5 * dt * a) /
+                 (1.0 + 0.5 * alpha * averaged_step);
+      } else {
+        v_half = ((1.0 - 0.5 * alpha * averaged_step) * v_half + averaged_step * a) /
+                 (1.0 + 0.5 * alpha * averaged_step);
+      }
+    } else if (window_boundary) {
+      v_half = state_.velocity + 0.5 * dt * a;
     } else {
       v_half += averaged_step * a;
     }
+    window_boundary = false;
     apply_constraints(v_half);
     Eigen::Matrix3Xd& dx = step_increment_;  // no allocation per step
     dx.noalias() = dt * v_half;
@@ -398,9 +523,7 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
     compute_contact_force();
     compute_external_force(state_.time, nodal_forces);
     add_work(dx);
-    a = (state_.external_force + state_.contact_force - state_.internal_force).array().rowwise() *
-        inverse_mass.transpose();
-    apply_constraints(a);
+    compute_acceleration(inverse_mass);
     state_.velocity = v_half + 0.5 * dt * a;
     update_kinetic_energy();
   }
@@ -414,6 +537,7 @@ void ExplicitSolver::add_work(const Eigen::Matrix3Xd& dx) {
   }
   state_.energy.external_work += 0.5 * state_.external_force.cwiseProduct(dx).sum();
   state_.energy.contact_work -= 0.5 * state_.contact_force.cwiseProduct(dx).sum();
+  if (tie_) state_.energy.tie_work -= 0.5 * state_.tie_force.cwiseProduct(dx).sum();
 }
 
 }  // namespace valvefsi::solid

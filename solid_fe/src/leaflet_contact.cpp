@@ -62,7 +62,8 @@ LeafletContact::LeafletContact(const ShellModel& model, std::vector<int> surface
   search_radius_ = 1.3 * max_reach + max_thickness + margin_;
 }
 
-void LeafletContact::rebuild(const ShellModel& model, const Eigen::Matrix3Xd& x) {
+void LeafletContact::rebuild(const ShellModel& model, const Eigen::Matrix3Xd& x,
+                             ContactCandidates& candidates) const {
   const auto num_elements = static_cast<Eigen::Index>(model.elements.size());
   Eigen::Matrix3Xd centroids(3, num_elements);
   for (Eigen::Index e = 0; e < num_elements; ++e) {
@@ -71,7 +72,8 @@ void LeafletContact::rebuild(const ShellModel& model, const Eigen::Matrix3Xd& x)
   }
   using Tree = nanoflann::KDTreeEigenMatrixAdaptor<Eigen::Matrix3Xd, 3, nanoflann::metric_L2_Simple, false>;
   const Tree tree(3, std::cref(centroids), 16);
-  pairs_.clear();
+  auto& pairs = candidates.pairs;
+  pairs.clear();
   std::vector<std::pair<Eigen::Index, double>> matches;
   const nanoflann::SearchParams params(32, 0.0f, false);
   for (Eigen::Index i = 0; i < x.cols(); ++i) {
@@ -86,22 +88,23 @@ void LeafletContact::rebuild(const ShellModel& model, const Eigen::Matrix3Xd& x)
           surface_of_node_[static_cast<std::size_t>(nodes[0])] == surface_of_node_[static_cast<std::size_t>(i)]) {
         continue;
       }
-      pairs_.emplace_back(static_cast<std::int32_t>(i), static_cast<std::int32_t>(e));
+      pairs.emplace_back(static_cast<std::int32_t>(i), static_cast<std::int32_t>(e));
     }
   }
-  positions_at_build_ = x;
-  ++rebuilds_;
+  candidates.positions_at_build = x;
+  ++candidates.rebuilds;
 }
 
 std::int64_t LeafletContact::add_forces(const ShellModel& model, const Eigen::Matrix3Xd& x,
-                                        double stiffness_per_mass, Eigen::Matrix3Xd& forces) {
-  if (positions_at_build_.cols() != x.cols() ||
-      (x - positions_at_build_).colwise().norm().maxCoeff() > 0.5 * margin_) {
-    rebuild(model, x);
+                                        double stiffness_per_mass, Eigen::Matrix3Xd& forces,
+                                        ContactCandidates& candidates) const {
+  if (candidates.positions_at_build.cols() != x.cols() ||
+      (x - candidates.positions_at_build).colwise().norm().maxCoeff() > 0.5 * margin_) {
+    rebuild(model, x, candidates);
   }
   std::int64_t in_contact = 0;
   Eigen::Vector3d w;
-  for (const auto& [i, e] : pairs_) {
+  for (const auto& [i, e] : candidates.pairs) {
     const ShellElement& el = model.elements[static_cast<std::size_t>(e)];
     const Eigen::Vector3d p = x.col(i);
     const Eigen::Vector3d c = closest_point_on_triangle(p, x.col(el.nodes[0]), x.col(el.nodes[1]), x.col(el.nodes[2]), w);

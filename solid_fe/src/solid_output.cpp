@@ -2,6 +2,7 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
@@ -30,12 +31,18 @@ void write_scalar_attribute(hid_t object, const char* name, double value) {
 
 }  // namespace
 
-FieldWriter::FieldWriter(const std::filesystem::path& dir, const Mesh& mesh, ElementFamily family)
-    : dir_(dir), family_(family), num_nodes_(mesh.num_nodes()),
+std::string restarted_output_suffix(const std::filesystem::path& dir, double restart_time) {
+  if (!std::filesystem::exists(dir / "solid_series.h5") && !std::filesystem::exists(dir / "solid_fields.h5")) return "";
+  return fmt::format("_t_{:.9f}", restart_time);
+}
+
+FieldWriter::FieldWriter(const std::filesystem::path& dir, const Mesh& mesh, ElementFamily family,
+                         const std::string& suffix)
+    : dir_(dir), stem_("solid_fields" + suffix), family_(family), num_nodes_(mesh.num_nodes()),
       num_elements_(family == ElementFamily::shell ? mesh.num_triangles()
                                                    : static_cast<std::int64_t>(mesh.hexahedra.size())) {
   std::filesystem::create_directories(dir_);
-  const auto path = dir_ / "solid_fields.h5";
+  const auto path = dir_ / (stem_ + ".h5");
   file_ = H5Handle(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
   if (!file_.valid()) throw std::runtime_error(path.string() + ": cannot create output file");
   write_array(file_.get(), "/mesh/nodes", mesh.nodes.data(), static_cast<hsize_t>(num_nodes_), 3);
@@ -74,15 +81,15 @@ void FieldWriter::write(const ExplicitSolver& solver, double& peak_stress, doubl
 }
 
 void FieldWriter::write_xdmf() const {
-  const auto path = dir_ / "solid_fields.xdmf";
-  const auto tmp = dir_ / "solid_fields.xdmf.tmp";
+  const auto path = dir_ / (stem_ + ".xdmf");
+  const auto tmp = dir_ / (stem_ + ".xdmf.tmp");
   {
     std::ofstream out(tmp);
     out << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
         << "  <Grid Name=\"leaflets\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
     const bool shell = family_ == ElementFamily::shell;
     for (std::size_t k = 0; k < times_.size(); ++k) {
-      const std::string g = fmt::format("solid_fields.h5:/snapshots/{:06d}", k);
+      const std::string g = fmt::format("{}.h5:/snapshots/{:06d}", stem_, k);
       const auto vec = [&](const char* name, const char* center) {
         return fmt::format(
             "    <Attribute Name=\"{0}\" AttributeType=\"Vector\" Center=\"{1}\">\n"
@@ -98,9 +105,9 @@ void FieldWriter::write_xdmf() const {
       out << fmt::format("   <Grid Name=\"t{}\" GridType=\"Uniform\">\n    <Time Value=\"{:.9g}\"/>\n", k, times_[k])
           << fmt::format("    <Topology TopologyType=\"{0}\" NumberOfElements=\"{1}\">\n"
                          "     <DataItem Dimensions=\"{1} {2}\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">"
-                         "solid_fields.h5:/mesh/{3}</DataItem>\n    </Topology>\n",
+                         "{4}.h5:/mesh/{3}</DataItem>\n    </Topology>\n",
                          shell ? "Triangle" : "Hexahedron", num_elements_, shell ? 3 : 8,
-                         shell ? "triangles" : "hexahedra")
+                         shell ? "triangles" : "hexahedra", stem_)
           << fmt::format("    <Geometry GeometryType=\"XYZ\">\n"
                          "     <DataItem Dimensions=\"{} 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">"
                          "{}/position</DataItem>\n    </Geometry>\n", num_nodes_, g)
@@ -113,8 +120,9 @@ void FieldWriter::write_xdmf() const {
 }
 
 SeriesWriter::SeriesWriter(std::filesystem::path dir,
-                           std::vector<std::pair<std::string, std::vector<std::int64_t>>> monitors)
-    : dir_(std::move(dir)), monitors_(std::move(monitors)), monitor_positions_(monitors_.size()) {
+                           std::vector<std::pair<std::string, std::vector<std::int64_t>>> monitors,
+                           const std::string& suffix)
+    : dir_(std::move(dir)), stem_("solid_series" + suffix), monitors_(std::move(monitors)), monitor_positions_(monitors_.size()) {
   std::filesystem::create_directories(dir_);
 }
 
@@ -139,6 +147,15 @@ void SeriesWriter::sample(const ExplicitSolver& solver, double pressure_Pa) {
   columns_["energy/external_work"].push_back(e.external_work);
   columns_["energy/damping_work"].push_back(e.damping_work);
   columns_["energy/contact_work"].push_back(e.contact_work);
+  if (s.tie_force.cols() > 0) {  // coaptation tie: work done against it, stored now, state
+    columns_["energy/tie_work"].push_back(e.tie_work);
+    columns_["energy/tie_energy"].push_back(e.tie_energy);
+    columns_["tie/tied_groups"].push_back(static_cast<double>(
+        std::count(s.tie.tied.begin(), s.tie.tied.end(), std::uint8_t{1})));
+    columns_["tie/releases"].push_back(static_cast<double>(s.tie.releases));
+    columns_["tie/peak_force"].push_back(s.tie.peak_force);
+  }
+  columns_["energy/interface_work"].push_back(e.interface_work);
   if (s.hourglass_force.cols() > 0) {  // bricks: bending lives in the hourglass modes
     columns_["energy/hourglass_work"].push_back(e.hourglass_work);
     columns_["energy/hourglass_energy"].push_back(e.hourglass_energy);
@@ -164,8 +181,8 @@ void SeriesWriter::add_snapshot_peaks(double time, double peak_stress, double pe
 }
 
 void SeriesWriter::flush() const {
-  const auto path = dir_ / "solid_series.h5";
-  const auto tmp = dir_ / "solid_series.h5.tmp";
+  const auto path = dir_ / (stem_ + ".h5");
+  const auto tmp = dir_ / (stem_ + ".h5.tmp");
   {
     H5Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
     if (!file.valid()) throw std::runtime_error(tmp.string() + ": cannot create output file");

@@ -126,6 +126,50 @@ TEST(SolidParticipant, StripCoupledIn2DMatchesFeOnly) {
               100 * (b.y() / deflection - 1));
 }
 
+// Energy in coupled runs (docs/solid_fe.md, "Energy in coupled runs"): the solid's figure of the
+// coupler's load work equals the coupler's own (sum of power_solid x window size, J/m in 2D, times
+// the strip depth); the work the loads do on the solid differs from it by the explicit coupling's
+// interface energy error, first order in the window size; the solid's own balance closes.
+struct CoupledEnergy {
+  double solid_external = 0, solid_interface = 0, coupler_interface = 0, balance_error = 0;
+};
+
+CoupledEnergy strip_energy(const std::string& name, double window) {
+  SolidRunSpec spec = strip_cantilever(name);
+  spec.solid_extra = "material: NEO_HOOKEAN neo_hookean { shear_modulus_kPa: 100 } strip_depth: 1e-3";
+  spec.fluid_args = {"--pressure", "100", "--damping", "20"};
+  spec.coupling_extra = fmt::format("window_size: {}", window);
+  SolidCoupledRun run(spec);
+  EXPECT_EQ(run.wait(120), 0) << run.logs();
+  CoupledEnergy e;
+  const auto series = run.dir / "solid_series.h5";
+  e.solid_external = valvefsi::testing::read_series(series, "energy/external_work").back();
+  e.solid_interface = valvefsi::testing::read_series(series, "energy/interface_work").back();
+  e.balance_error = valvefsi::testing::read_series(series, "energy/relative_balance_error").back();
+  const auto power = valvefsi::testing::read_series(run.dir / "coupling_series.h5", "power_solid");
+  const auto size = valvefsi::testing::read_series(run.dir / "coupling_series.h5", "window_size");
+  for (std::size_t k = 0; k < power.size(); ++k) e.coupler_interface += power[k] * size[k] * 1e-3;  // J/m x depth
+  std::printf("window %g s: load work on the solid %.9e J, coupler's book %.9e J (solid's figure %.9e J), "
+              "difference %.3e J; balance error %.2e\n", window, e.solid_external, e.coupler_interface,
+              e.solid_interface, e.solid_external - e.coupler_interface, e.balance_error);
+  return e;
+}
+
+TEST(SolidParticipant, CoupledLoadWorkMatchesTheCouplersBookToFirstOrderInTheWindow) {
+  const CoupledEnergy coarse = strip_energy("solid-energy-coarse", 2e-4);
+  const CoupledEnergy fine = strip_energy("solid-energy-fine", 1e-4);
+  for (const auto& e : {coarse, fine}) {
+    EXPECT_NEAR(e.solid_interface, e.coupler_interface, 1e-9 * std::abs(e.coupler_interface));
+    EXPECT_GT(e.solid_external, 0.0);
+    EXPECT_NEAR(e.solid_external, e.coupler_interface, 0.05 * e.solid_external);
+    EXPECT_LT(e.balance_error, 1e-3);
+  }
+  const double ratio = (coarse.solid_external - coarse.coupler_interface) / (fine.solid_external - fine.coupler_interface);
+  EXPECT_GT(ratio, 1.6) << "first order in the window size";
+  EXPECT_LT(ratio, 2.5);
+  std::printf("difference ratio for halved windows: %.3f\n", ratio);
+}
+
 // Bricks as the participant: the fluid sees the mid-surface (pairs of ventricular/aortic nodes),
 // its forces go half to each node of a pair. Under the stand-in pressure the brick cantilever
 // moves as the FE-only bricks under the same pressure on their ventricular faces.

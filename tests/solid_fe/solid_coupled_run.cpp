@@ -11,7 +11,8 @@
 namespace valvefsi::solid::testing {
 
 SolidCoupledRun::SolidCoupledRun(const SolidRunSpec& spec, bool fe_only)
-    : dir(valvefsi::testing::fresh_directory(spec.name)) {
+    : dir(valvefsi::testing::fresh_directory(spec.name)),
+      output(spec.output_dir.empty() ? dir : std::filesystem::path(spec.output_dir)) {
   write_mesh(dir / "strip.mesh.h5", spec.mesh);
   const auto case_file = dir / "case.textproto";
   valvefsi::testing::write_file(
@@ -22,7 +23,7 @@ SolidCoupledRun::SolidCoupledRun(const SolidRunSpec& spec, bool fe_only)
                   "startup_timeout_s: 30 {} }}\n",
                   spec.end_time, dir.string(), spec.run_extra, spec.waveform, spec.solid_extra, dir.string(),
                   spec.coupling_extra));
-  const std::vector<std::string> common = {"--case", case_file.string(), "--output", dir.string()};
+  const std::vector<std::string> common = {"--case", case_file.string(), "--output", output.string()};
   auto with = [&](std::vector<std::string> argv, const std::vector<std::string>& extra) {
     argv.insert(argv.end(), extra.begin(), extra.end());
     argv.insert(argv.end(), common.begin(), common.end());
@@ -30,11 +31,12 @@ SolidCoupledRun::SolidCoupledRun(const SolidRunSpec& spec, bool fe_only)
   };
   const std::vector<std::string> env = {"OMP_NUM_THREADS=1", "OMP_WAIT_POLICY=passive"};
   if (fe_only) {
-    solid = std::make_unique<valvefsi::testing::ChildProcess>(with({SOLID_FE_EXECUTABLE}, {"--fe-only"}),
-                                                              dir / "solid.log", env);
+    std::vector<std::string> args = {"--fe-only"};
+    args.insert(args.end(), spec.solid_args.begin(), spec.solid_args.end());
+    solid = std::make_unique<valvefsi::testing::ChildProcess>(with({SOLID_FE_EXECUTABLE}, args), dir / "solid.log", env);
     return;
   }
-  coupler = std::make_unique<valvefsi::testing::ChildProcess>(with({valvefsi::testing::coupler_exe()}, {}),
+  coupler = std::make_unique<valvefsi::testing::ChildProcess>(with({valvefsi::testing::coupler_exe()}, spec.coupler_args),
                                                               dir / "coupler.log");
   solid = std::make_unique<valvefsi::testing::ChildProcess>(with({SOLID_FE_EXECUTABLE}, {}), dir / "solid.log", env);
   fluid = std::make_unique<valvefsi::testing::ChildProcess>(with({spec.fluid_exe}, spec.fluid_args),
@@ -55,8 +57,8 @@ int SolidCoupledRun::wait(double timeout_s) {
   return code;
 }
 
-Eigen::Matrix3Xd SolidCoupledRun::final_monitor(const std::string& set) const {
-  const auto file = dir / "solid_series.h5";
+Eigen::Matrix3Xd SolidCoupledRun::final_monitor(const std::string& set, const std::string& series) const {
+  const auto file = output / series;
   const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   if (f < 0) throw std::runtime_error("cannot open " + file.string());
   const std::string name = "/monitor/" + set + "/position";

@@ -24,18 +24,22 @@ struct SolidRunSpec {
   double end_time = 0.01;
   std::string fluid_exe;       // absolute path
   std::vector<std::string> fluid_args;
+  std::vector<std::string> coupler_args;  // e.g. {"--restart", folder}
+  std::vector<std::string> solid_args;    // e.g. FE-only {"--restart", folder}
+  std::string output_dir;                 // default: the run's fresh folder
 };
 
 class SolidCoupledRun {
  public:
   // Writes mesh and case; starts coupler, solid_fe (participant) and the fluid.
   explicit SolidCoupledRun(const SolidRunSpec& spec, bool fe_only = false);
-  std::filesystem::path dir;
+  std::filesystem::path dir;     // the case and logs
+  std::filesystem::path output;  // the programs' output folder (dir unless the spec names one)
   std::unique_ptr<valvefsi::testing::ChildProcess> coupler, solid, fluid;
   // Exit code of the solid (-1 if it did not end within the timeout); waits for all.
   int wait(double timeout_s);
   // Last sample of /monitor/<set>/position in the solid's series file (3 x nodes).
-  Eigen::Matrix3Xd final_monitor(const std::string& set) const;
+  Eigen::Matrix3Xd final_monitor(const std::string& set, const std::string& series = "solid_series.h5") const;
   std::string logs() const;
 };
 

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "valvefsi/solid/coaptation_tie.hpp"
 #include "valvefsi/solid/element_model.hpp"
 #include "valvefsi/solid/leaflet_contact.hpp"
 #include "valvefsi/solid/mesh.hpp"
@@ -28,10 +29,17 @@ struct EnergyBalance {
   double external_work = 0;     // work of pressure and coupler forces (J)
   double damping_work = 0;      // dissipated by mass-proportional damping (J)
   double contact_work = 0;      // stored/dissipated in contact penalties (J)
+  double tie_work = 0;          // done against coaptation ties: stored now + lost at releases (J)
+  double tie_energy = 0;        // stored in the tied springs now (J)
+  // Coupled runs: the work of the coupler's loads as the coupler books it, sum over windows of
+  // F_w . v(window start) * window size (J; 2D: the coupler's J/m times the strip depth). The
+  // solid's own external_work books F_w . (x_end - x_start); the two differ by the explicit
+  // coupling's interface energy error (docs/solid_fe.md, "Energy in coupled runs").
+  double interface_work = 0;
   double initial_kinetic = 0;
-  // KE + W_int + W_damp + W_contact - W_ext - KE0: zero for exact time integration.
+  // KE + W_int + W_damp + W_contact + W_tie - W_ext - KE0: zero for exact time integration.
   double balance() const {
-    return kinetic + internal_work + damping_work + contact_work - external_work - initial_kinetic;
+    return kinetic + internal_work + damping_work + contact_work + tie_work - external_work - initial_kinetic;
   }
   // |balance| relative to the largest energy term.
   double relative_balance_error() const;
@@ -47,6 +55,7 @@ struct SolverState {
   Eigen::Matrix3Xd hourglass_force;    // its hourglass part (bricks; empty for shells)
   Eigen::Matrix3Xd external_force;     // at `position`, last evaluated
   Eigen::Matrix3Xd contact_force;      // at `position`
+  Eigen::Matrix3Xd tie_force;          // coaptation tie springs at `position` (empty without a tie)
   std::int64_t nodes_in_contact = 0;
   double last_step = 0;                // dt of the last step
   // The last step before it was cut to land on a window's or an output's end. The growth limit
@@ -64,6 +73,11 @@ struct SolverState {
   std::int64_t calibrated_at_step = -1;
   int calibration_iterations = 0;      // Lanczos steps of the last calibration
   Eigen::Matrix3Xd power_vector;       // last eigenvector estimate
+  // Contact: omega^2 fixing the penalty stiffness (set at the first step, then constant) and the
+  // leaflet-leaflet candidate pairs (their order sets the order of the force sums).
+  double contact_omega2 = 0.0;
+  ContactCandidates contact_candidates;
+  CoaptationTieState tie;
 };
 
 struct SymmetryConstraint {
@@ -122,6 +136,10 @@ class ExplicitSolver {
   // (mass-weighted, so momentum and the energy balance hold).
   void set_strip_ties(std::vector<StripTie> ties);
   const std::vector<StripTie>& strip_ties() const { return ties_; }
+  // Coaptation tie (coaptation_tie.hpp): its plane must be one of the contact planes added.
+  // Throws std::invalid_argument for an unknown plane, node or a non-positive release force.
+  void set_coaptation_tie(CoaptationTie tie);
+  const std::optional<CoaptationTie>& coaptation_tie() const { return tie_; }
   const LeafletContact* leaflet_contact() const { return leaflet_contact_ ? &*leaflet_contact_ : nullptr; }
   void set_velocity(const Eigen::Matrix3Xd& velocity);  // initial condition (before the first step)
 
@@ -159,6 +177,10 @@ class ExplicitSolver {
   void calibrate_stable_step(double element_step);
   void compute_external_force(double t, const Eigen::Matrix3Xd* nodal_forces);
   void compute_contact_force();
+  // Catches touching tip groups, releases over-pulled ones, and sets state_.tie_force.
+  void update_coaptation_tie(double stiffness_per_mass);
+  // (external + contact + tie - internal) / m with the constraints applied, into acceleration_.
+  void compute_acceleration(const Eigen::ArrayXd& inverse_mass);
   void apply_constraints(Eigen::Matrix3Xd& field) const;
   void update_kinetic_energy();
   void add_work(const Eigen::Matrix3Xd& dx);
@@ -173,7 +195,9 @@ class ExplicitSolver {
   std::vector<StripTie> ties_;
   bool planar_ = false;  // u_z = 0 everywhere (strip mode)
   std::optional<LeafletContact> leaflet_contact_;
-  double contact_omega2_ = 0.0;  // frequency^2 fixing the penalty stiffness, set at the first step
+  std::optional<CoaptationTie> tie_;
+  std::size_t tie_plane_ = 0;           // index of the tie's plane in contact_planes_
+  std::vector<std::uint8_t> tie_held_;  // per node: held by a tie now (the tie's plane skips it)
   double step_factor_ = 0.0;     // > 0: tests' override of the safety factor
   Eigen::VectorXd half_thickness_;  // per node: contact offset of the surface
   Eigen::Matrix3Xd acceleration_;

@@ -54,6 +54,15 @@ LEAFLET_SHAPES = ("flat", "belly")
 # spikes of ~100 mmHg in the opening (xcoarse, measured; docs/fsi-2d.md) and the coarse valve
 # stalled at 0.061 s (the lead's investigation).
 BACKGROUND_PRESSURE_2D = False
+# The coaptation tie (solid_fe, docs/solid_fe.md "Coaptation tie"): the touching tips are held
+# on the annulus plane until the tie pulls harder than this per metre of depth. A forward
+# gradient dp loads the 11.25 mm flap with dp L = 1.5 N/m per mmHg, and a flap held at both ends
+# pulls on its tip about 2.8x its load (the solid's test: membrane tension), ~4.2 N/m per mmHg:
+# 10 N/m lets go near 2.4 mmHg forward (the waveform passes it ~5 ms into ejection, before the
+# FSI valve's inertia lets it move) and holds against the diastolic sloshing dips that lifted
+# the untied tips (docs/fsi-2d.md).
+COAPTATION_TIE = True
+COAPTATION_TIE_RELEASE_N_PER_M = 10.0
 # Contact plane holding the closed 2D valve (docs/fsi-2d.md).
 ANNULUS_PLANE = "annulus"
 
@@ -429,6 +438,9 @@ def case_text_2d(spec: Case2D) -> str:
              + strip_depth_line() + fe_only_settings +
              "  fixed_node_sets: \"attachment\"\n"
              "  monitor_node_sets: \"free_edge_midpoints\"\n"
+             + (f"  # the coapted tips stay on the annulus plane until pulled by {COAPTATION_TIE_RELEASE_N_PER_M:g} N/m (valve2d.py)\n"
+                f"  coaptation_tie {{ contact_plane: \"{ANNULUS_PLANE}\" release_force_N_per_m: {COAPTATION_TIE_RELEASE_N_PER_M:g} }}\n"
+                if COAPTATION_TIE else "") +
              "}\n")
     parts = [header_2d(spec), f"title: \"{title}\"\n", run, waveform.waveform_textproto(), solid]
     if spec.kind == "FSI":

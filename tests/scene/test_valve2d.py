@@ -194,6 +194,16 @@ class CaseFiles2D(unittest.TestCase):
                 for vector in re.findall(r"(?:lower|upper|point|position|origin|axis|normal|domain_lower|domain_upper|lattice_origin): (\[[^\]]*\])", text):
                     self.assertEqual(vector.count(",") + 1, 2, vector)
 
+    def test_tips_tied_to_the_annulus_plane(self):
+        # every 2D case ties the coapted tips to the annulus contact plane of its own mesh
+        for spec in all_specs_2d():
+            text = case_text_2d(spec)
+            tie = re.search(r'coaptation_tie \{ contact_plane: "(\w+)" release_force_N_per_m: ([0-9.eE+-]+) \}', text)
+            self.assertIsNotNone(tie, spec.name)
+            self.assertEqual(tie.group(1), valve2d.ANNULUS_PLANE)
+            self.assertIn(tie.group(1), build_strip_mesh(spec.resolution).contact_planes)
+            self.assertGreater(float(tie.group(2)), 0.0)
+
     def test_stent_faces_and_plate_faces_on_lattice_planes(self):
         for dp in valve2d.PARTICLE_SPACING_2D.values():
             ch = Channel2D().on_lattice(dp)

@@ -92,6 +92,9 @@ int main(int argc, char** argv) {
   // MPI only under a launcher; a rank that fails takes the others down (they would wait on it).
   const bool mpi = app::started_by_mpi_launcher();
   if (mpi) {
+    // Ranks that wait yield the core instead of spinning (the machine is shared, as with
+    // OMP_WAIT_POLICY=passive); an explicit setting in the environment wins.
+    setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0);
     int provided = 0;
     MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
     if (!app::mpi_world().root()) spdlog::set_level(spdlog::level::warn);

@@ -12,6 +12,8 @@
 #include <filesystem>
 #include <map>
 
+#include <unistd.h>
+
 #include "coupled_run.hpp"
 #include "process_harness.hpp"
 
@@ -23,14 +25,15 @@ using valvefsi::testing::read_series;
 constexpr double kEnd = 0.02;  // 2T
 constexpr int kSnapshotsPerRun = 4;
 
-struct Run {
+struct RunResult {
   std::filesystem::path dir;
   int fluid = -1, solid = -1, coupler = -1;
   std::string fluid_log, coupler_log;
 };
 
-Run run(const std::string& name, const std::string& interface_model, const std::string& restart_from) {
-  Run r;
+// ranks > 1: the fluid runs under mpiexec, split into slabs (rank 0 talks to the coupler).
+RunResult run(const std::string& name, const std::string& interface_model, const std::string& restart_from, int ranks = 1) {
+  RunResult r;
   r.dir = valvefsi::testing::fresh_directory(name);
   const auto case_file = r.dir / "case.textproto";
   // Shifting on (its kernel sums are restart state too), fixed-wall loads booked every step.
@@ -77,7 +80,13 @@ coupling {{
   // A still leaflet standing in the column at x = 0.025, from inside the floor to above the water.
   ChildProcess solid(with({VALVEFSI_TEST_LEAFLET_SOLID}, {"--x", "0.025", "--y0", "-0.01", "--y1", "0.14", "--nodes", "31"}),
                      r.dir / "solid.log");
-  ChildProcess fluid(with({VALVEFSI_TEST_FLUID_SPH}, {"--threads", "1"}), r.dir / "fluid.log",
+  std::vector<std::string> fluid_command = {VALVEFSI_TEST_FLUID_SPH};
+  if (ranks > 1) {
+    fluid_command = {VALVEFSI_TEST_MPIEXEC, "-n", std::to_string(ranks), "--oversubscribe"};
+    if (::geteuid() == 0) fluid_command.push_back("--allow-run-as-root");
+    fluid_command.push_back(VALVEFSI_TEST_FLUID_SPH);
+  }
+  ChildProcess fluid(with(fluid_command, {"--threads", "1"}), r.dir / "fluid.log",
                      std::vector<std::string>{"VALVEFSI_COUPLER_ENDPOINT=ipc://" + r.dir.string() + "/c.ipc"});
   const auto f = fluid.wait_for_exit(std::chrono::seconds(240));
   const auto s = solid.wait_for_exit(std::chrono::seconds(20));
@@ -95,8 +104,8 @@ std::vector<T> tail(const std::vector<T>& all, std::size_t n) {
   return {all.end() - static_cast<std::ptrdiff_t>(std::min(n, all.size())), all.end()};
 }
 
-void expect_restart_continues_bit_for_bit(const std::string& name, const std::string& interface_model) {
-  const Run whole = run(name + "-whole", interface_model, "");
+void expect_restart_continues_bit_for_bit(const std::string& name, const std::string& interface_model, int ranks = 1) {
+  const RunResult whole = run(name + "-whole", interface_model, "", ranks);
   if (whole.fluid_log.find("no restart capability") != std::string::npos)
     GTEST_SKIP() << "the immersed-surface model cannot write restart state yet:\n" << whole.fluid_log;
   ASSERT_EQ(whole.fluid, 0) << whole.fluid_log;
@@ -104,8 +113,9 @@ void expect_restart_continues_bit_for_bit(const std::string& name, const std::st
   const auto point = whole.dir / "restart" / "t_0.010000000";
   ASSERT_TRUE(std::filesystem::exists(point / "COMPLETE")) << whole.coupler_log;
   ASSERT_TRUE(std::filesystem::exists(point / "fluid.restart.h5"));
+  for (int k = 1; k < ranks; ++k) ASSERT_TRUE(std::filesystem::exists(point / fmt::format("fluid.rank{}.restart.h5", k)));
 
-  const Run resumed = run(name + "-resumed", interface_model, point.string());
+  const RunResult resumed = run(name + "-resumed", interface_model, point.string(), ranks);
   ASSERT_EQ(resumed.fluid, 0) << resumed.fluid_log;
   ASSERT_EQ(resumed.coupler, 0) << resumed.coupler_log;
   EXPECT_NE(resumed.fluid_log.find("continuing from"), std::string::npos) << resumed.fluid_log;
@@ -158,6 +168,27 @@ TEST(FluidRestart, FluidWithoutLeafletContinuesBitForBit) {
 
 TEST(FluidRestart, FluidWithThinWallLeafletContinuesBitForBit) {
   expect_restart_continues_bit_for_bit("fluid_restart_thin_wall", "THIN_WALL");
+}
+
+// The fluid split over two MPI ranks under the coupler: restart files per rank continue bit
+// for bit, and the split run's probes equal the one-rank run's (to round-off).
+TEST(FluidRestart, FluidOnTwoRanksContinuesBitForBitAndMatchesOneRank) {
+  expect_restart_continues_bit_for_bit("fluid_restart_split", "NONE", 2);
+  const RunResult single = run("fluid_restart_single", "NONE", "", 1);
+  ASSERT_EQ(single.fluid, 0) << single.fluid_log;
+  const auto split_dir = std::filesystem::temp_directory_path() / ("vfsi-fluid_restart_split-whole-" + std::to_string(::getpid()));
+  for (const char* dataset : {"pressure/bottom", "wall_force/fixed_walls"}) {
+    const auto split = read_series(split_dir / "fluid_probes.h5", dataset);
+    const auto one = read_series(single.dir / "fluid_probes.h5", dataset);
+    ASSERT_EQ(split.size(), one.size());
+    double worst = 0, scale = 0;
+    for (std::size_t i = 0; i < split.size(); ++i) {
+      worst = std::max(worst, std::abs(split[i] - one[i]));
+      scale = std::max(scale, std::abs(one[i]));
+    }
+    std::printf("%s, 2 ranks vs 1: largest difference %.3e of %.3e\n", dataset, worst, scale);
+    EXPECT_LE(worst, 1e-6 * scale) << dataset;
+  }
 }
 
 }  // namespace

@@ -101,7 +101,37 @@ int run_case_at_rest(const std::string& case_file, const std::string& surface_fi
     if (const char* dump = std::getenv("THIN_WALL_PARTICLE_DUMP")) write_particle_dump(dump, solver, *model);
   }
   const auto t0 = std::chrono::steady_clock::now();
-  for (long k = 0; k < steps; ++k) solver.step();
+  // THIN_WALL_PRINT_EVERY=N: every N steps the time, the net force on the surface, its mean
+  // node load over the node areas and the largest fluid speed (the at-rest history).
+  const long every = std::getenv("THIN_WALL_PRINT_EVERY") ? std::atol(std::getenv("THIN_WALL_PRINT_EVERY")) : 0;
+  for (long k = 0; k < steps; ++k) {
+    solver.step();
+    if (every > 0 && (k + 1) % every == 0) {
+      const auto& p = solver.particles();
+      double v2 = 0;
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (p.kind[i] == Kind::fluid)
+          v2 = std::max(v2, static_cast<double>(p.velocity[0][i] * p.velocity[0][i] + p.velocity[1][i] * p.velocity[1][i] +
+                                                p.velocity[2][i] * p.velocity[2][i]));
+      double load = 0, area = 0;
+      Vec3 f{0, 0, 0};
+      if (model) {
+        std::vector<Vec<3>> forces(model->node_count());
+        model->node_forces(forces);
+        for (std::size_t j = 0; j < forces.size(); ++j) {
+          load += std::sqrt(forces[j][0] * forces[j][0] + forces[j][1] * forces[j][1] + forces[j][2] * forces[j][2]);
+          area += model->node_areas()[j];
+          for (int d = 0; d < 3; ++d) f[d] += forces[j][d];
+        }
+      }
+      std::printf("step %ld t %.4e s: net force %.4g %.4g %.4g N, mean node load %.4g Pa, net/area %.4g Pa, max speed %.4g m/s, "
+                  "leaks %zu\n",
+                  k + 1, solver.time(), f[0], f[1], f[2], area > 0 ? load / area : 0.0,
+                  area > 0 ? std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) / area : 0.0, std::sqrt(v2),
+                  model ? model->counters().leaks : std::size_t{0});
+      std::fflush(stdout);
+    }
+  }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("%s: %zu particles, %ld steps to t = %.3g s, %.2f s, %.2f ms/step\n", no_surface ? "no surface" : "with surface",
               solver.particles().size(), steps, solver.time(), wall, 1e3 * wall / static_cast<double>(steps));

@@ -41,14 +41,19 @@ int run_standalone(const valvefsi::cases::Case& c, const std::filesystem::path& 
   app::RunOutput<D> run_output(probes, plate_count, false, output, end_time, c.run().snapshot_interval(),
                                c.run().series_interval(), world.root());
   const long first_step = solver.step_count();
-  while (true) {
-    run_output.write_due(solver);
-    if (solver.time() >= end_time * (1 - 1e-12)) break;
-    if (c.run().series_interval() <= 0) {
-      solver.step();
-    } else {
-      solver.advance_to(run_output.next_due());
+  try {
+    while (true) {
+      run_output.write_due(solver);
+      if (solver.time() >= end_time * (1 - 1e-12)) break;
+      if (c.run().series_interval() <= 0) {
+        solver.step();
+      } else {
+        solver.advance_to(run_output.next_due());
+      }
     }
+  } catch (const TimeStepCollapse&) {
+    run_output.write_last_state(solver);  // every rank sees the collapse (the step is common)
+    throw;
   }
   run_output.flush();
   const double wall = run_output.elapsed();

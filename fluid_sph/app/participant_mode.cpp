@@ -250,7 +250,12 @@ int run_coupled(const cases::Case& c, const std::filesystem::path& case_file, co
       }
       if (model != nullptr) model->set_window_target(window.end(), end_positions, end_velocities);
       solver.reset_surface_force_average();
-      solver.advance_to(window.end());
+      try {
+        solver.advance_to(window.end());
+      } catch (const TimeStepCollapse&) {
+        run_output.write_last_state(solver, last_total);  // every rank sees the collapse (the step is common)
+        throw;
+      }
       const std::vector<Vec<D>> forces = solver.surface_force_average();
       last_total = Vec<D>{};
       for (std::size_t j = 0; j < forces.size(); ++j)  // none without a surface model: zero loads

@@ -88,6 +88,25 @@ class RunOutput {
   void flush() {
     if (root_) series_.flush();
   }
+
+  // The state a failed run stopped in (collective when split): a snapshot and a probe row,
+  // then the series is written, so the failure can be looked at.
+  void write_last_state(const FluidSolver<D>& solver, const Vec<D>& interface_force = {}) {
+    snapshots_.write(solver);
+    if (solver.time() > last_sample_time_) sample(solver, interface_force);
+    flush();
+  }
+
+  // A run that stops on an error still leaves its probe series readable.
+  ~RunOutput() {
+    try {
+      flush();
+    } catch (const std::exception& e) {
+      spdlog::error("fluid_sph: could not write the probe series: {}", e.what());
+    }
+  }
+  RunOutput(const RunOutput&) = delete;
+  RunOutput& operator=(const RunOutput&) = delete;
   double elapsed() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
 
  private:
@@ -112,6 +131,7 @@ class RunOutput {
       row.push_back(static_cast<double>(counters.leaks));
     }
     series_.append(solver.time(), row);
+    last_sample_time_ = solver.time();
   }
 
   ProbeSet<D> probes_;
@@ -122,6 +142,7 @@ class RunOutput {
   SeriesWriter series_;
   double end_time_, snapshot_interval_, series_interval_;
   double next_snapshot_ = 0.0, next_sample_ = 0.0;
+  double last_sample_time_ = -1.0;
   Clock::time_point start_, last_report_;
 };
 

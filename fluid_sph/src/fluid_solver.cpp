@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <optional>
@@ -491,14 +492,67 @@ void FluidSolver<D>::choose_time_step() {
   double dt_at_rest = std::min(s.cfl * h / s.sound_speed, s.max_time_step);
   if (s.dynamic_viscosity > 0) dt_at_rest = std::min(dt_at_rest, 0.125 * h * h * s.rest_density / s.dynamic_viscosity);
   if (s.min_time_step_ratio > 0 && dt_ < s.min_time_step_ratio * dt_at_rest) {
-    throw std::runtime_error(fmt::format(
-        "time step collapsed at t = {:.6g} s: dt = {:.3g} s < {:g} x the step at rest ({:.3g} s); "
+    const double acoustic = s.cfl * h / (s.sound_speed + speed);
+    const char* limit = dt_ == s.max_time_step ? "max_time_step"
+                        : dt_ == acoustic      ? "the acoustic limit (speed)"
+                        : (s.dynamic_viscosity > 0 && dt_ == 0.125 * h * h * s.rest_density / s.dynamic_viscosity)
+                            ? "the viscous limit"
+                            : "the force limit (acceleration)";
+    throw TimeStepCollapse(fmt::format(
+        "time step collapsed at t = {:.6g} s: dt = {:.3g} s < {:g} x the step at rest ({:.3g} s), set by {}; "
         "limits: largest fluid speed {:.3g} m/s, leaflet node speed {:.3g} m/s, largest acceleration {:.3g} m/s^2 "
-        "(a particle squeezed between walls or a blow-up); lower the window or the CFL, raise the sound speed, "
+        "(a particle squeezed between walls or a blow-up); {}; lower the window or the CFL, raise the sound speed, "
         "or set fluid.min_time_step_ratio to go on",
-        time_, dt_, s.min_time_step_ratio, dt_at_rest, max_speed_, surface_ ? surface_->max_node_speed() : 0.0,
-        max_acceleration_));
+        time_, dt_, s.min_time_step_ratio, dt_at_rest, limit, max_speed_, surface_ ? surface_->max_node_speed() : 0.0,
+        max_acceleration_, describe_extremes()));
   }
+}
+
+template <int D>
+std::string FluidSolver<D>::describe_extremes() const {
+  // Per rank the own fluid particle of largest acceleration and of largest speed: value, id,
+  // position (3), speed, density; the largest over the ranks wins.
+  const auto& p = particles_;
+  constexpr int kFields = 7;
+  std::array<double, 2 * kFields> mine{};
+  mine[0] = mine[kFields] = -1.0;
+  for (std::size_t i = owned_begin_; i < owned_end_; ++i) {
+    if (p.kind[i] != Kind::fluid) continue;
+    double v2 = 0, a2 = 0;
+    for (int d = 0; d < D; ++d) {
+      v2 += static_cast<double>(p.velocity[d][i]) * p.velocity[d][i];
+      a2 += static_cast<double>(p.acceleration[d][i]) * p.acceleration[d][i];
+    }
+    for (int which = 0; which < 2; ++which) {
+      const double value = std::sqrt(which == 0 ? a2 : v2);
+      double* slot = mine.data() + which * kFields;
+      if (value <= slot[0]) continue;
+      slot[0] = value;
+      slot[1] = p.id[i];
+      for (int d = 0; d < 3; ++d) slot[2 + d] = d < D ? p.position[d][i] : 0.0;
+      slot[5] = std::sqrt(v2);
+      slot[6] = settings_.rest_density + p.density_excess[i];
+    }
+  }
+  std::vector<double> all(mine.begin(), mine.end());
+  if (slabs_) {
+    all.resize(mine.size() * static_cast<std::size_t>(slabs_->size()));
+    MPI_Allgather(mine.data(), 2 * kFields, MPI_DOUBLE, all.data(), 2 * kFields, MPI_DOUBLE, slabs_->communicator());
+  }
+  std::string text;
+  for (int which = 0; which < 2; ++which) {
+    const double* best = nullptr;
+    for (std::size_t r = 0; r < all.size() / (2 * kFields); ++r) {
+      const double* slot = all.data() + r * 2 * kFields + which * kFields;
+      if (best == nullptr || slot[0] > best[0]) best = slot;
+    }
+    if (best == nullptr || best[0] < 0) continue;
+    text += fmt::format("{}{} {:.3g} {} at particle {} (x = {:.6g}, {:.6g}{}; speed {:.3g} m/s, density {:.6g} kg/m^3, rest {:g})",
+                        text.empty() ? "" : "; ", which == 0 ? "largest acceleration" : "largest speed", best[0],
+                        which == 0 ? "m/s^2" : "m/s", static_cast<long>(best[1]), best[2], best[3],
+                        D == 3 ? fmt::format(", {:.6g}", best[4]) : std::string(), best[5], best[6], settings_.rest_density);
+  }
+  return text.empty() ? "no fluid particle" : text;
 }
 
 template <int D>

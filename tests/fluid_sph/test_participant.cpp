@@ -201,4 +201,47 @@ fluid {{
   EXPECT_NEAR(pressure.back(), 1000 * 9.81 * 0.08, 0.1 * 1000 * 9.81 * 0.08);
 }
 
+// A run that stops on a collapsing time step (here forced by a guard of 0.97 of the step at
+// rest: the collapsing column soon moves faster than 3 % of c0) exits non-zero, says where,
+// and leaves its probe series and a snapshot of the state it stopped in.
+TEST(FluidProgram, TimeStepCollapseLeavesProbesAndLastState) {
+  const auto dir = valvefsi::testing::fresh_directory("fluid_collapse");
+  const auto case_file = dir / "case.textproto";
+  valvefsi::testing::write_file(case_file, fmt::format(R"(run {{ end_time: 0.5 output_dir: "{}" dimension: 2 series_interval: 0.01 snapshot_interval: 0.1 }}
+fluid {{
+  particle_spacing: 0.01
+  density: 1000
+  sound_speed: 20
+  artificial_viscosity: 0.02
+  gravity: [0, -9.81]
+  min_time_step_ratio: 0.97
+  domain_lower: [-0.05, -0.05]
+  domain_upper: [0.35, 0.3]
+  fluid_blocks {{ box {{ lower: [0, 0] upper: [0.1, 0.1] }} }}
+  walls {{ container {{ lower: [0, 0] upper: [0.3, 10] }} }}
+  probes {{ pressure_points {{ name: "bottom" position: [0.05, 0.02] }} }}
+}}
+)",
+                                                       dir.string()));
+  ChildProcess fluid({VALVEFSI_TEST_FLUID_SPH, "--case", case_file.string(), "--output", dir.string(), "--standalone",
+                      "--threads", "1"},
+                     dir / "fluid.log");
+  const auto code = fluid.wait_for_exit(std::chrono::seconds(120));
+  ASSERT_TRUE(code) << fluid.log_text();
+  EXPECT_EQ(*code, 1) << fluid.log_text();
+  const std::string log = fluid.log_text();
+  EXPECT_NE(log.find("time step collapsed"), std::string::npos) << log;
+  EXPECT_NE(log.find("set by the acoustic limit"), std::string::npos) << log;
+  EXPECT_NE(log.find("largest speed"), std::string::npos) << log;
+  const auto time = valvefsi::testing::read_series(dir / "fluid_probes.h5", "time");
+  ASSERT_GE(time.size(), 2u);
+  // The last row is the state it stopped in (between the regular rows), the rows before it are regular.
+  EXPECT_GT(time.back(), time[time.size() - 2]);
+  EXPECT_LT(time.back() - time[time.size() - 2], 0.01);
+  std::printf("stopped at t = %.6f s after %zu probe rows\n", time.back(), time.size());
+  const auto stopped = valvefsi::testing::read_series(dir / "fluid_particles.h5",
+                                                      fmt::format("snapshot_{:06d}/pressure", static_cast<int>(time.back() / 0.1) + 1));
+  EXPECT_FALSE(stopped.empty());
+}
+
 }  // namespace

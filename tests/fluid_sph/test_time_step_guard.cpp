@@ -46,6 +46,11 @@ TEST(TimeStepGuard, CollapseStopsTheRunAndSaysWhy) {
   EXPECT_NE(message.find("time step collapsed"), std::string::npos) << message;
   EXPECT_NE(message.find("largest fluid speed 1.2e+03 m/s"), std::string::npos) << message;
   EXPECT_NE(message.find("min_time_step_ratio"), std::string::npos) << message;
+  // Which limit, and where: the block moves at 1200 m/s, so the acoustic limit set the step and
+  // the fastest particle is one of the block's (inside 0.2..0.8 m, at rest density or near it).
+  EXPECT_NE(message.find("set by the acoustic limit"), std::string::npos) << message;
+  EXPECT_NE(message.find("largest speed 1.2e+03 m/s at particle"), std::string::npos) << message;
+  EXPECT_NE(message.find("density"), std::string::npos) << message;
 }
 
 TEST(TimeStepGuard, AStepAboveTheGuardRuns) {

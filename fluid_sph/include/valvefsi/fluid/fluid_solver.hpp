@@ -7,6 +7,8 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "valvefsi/fluid/cell_grid.hpp"
@@ -18,6 +20,14 @@
 #include "valvefsi/fluid/slab_decomposition.hpp"
 
 namespace valvefsi::fluid {
+
+// Thrown when the time step falls below FluidSettings::min_time_step_ratio of the step at rest;
+// what() says which limit, and where the fastest and the most accelerated particles are. The
+// solver's state is that of the last completed step (finite), so it can still be written.
+class TimeStepCollapse : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 template <int D>
 class FluidSolver {
@@ -98,6 +108,7 @@ class FluidSolver {
   void drop_mirror_images_and_reflect();
   void add_mirror_images();
   void update_owned_range();
+  std::string describe_extremes() const;
   PairFilter<D> pair_filter() const;
 
   struct Checkpoint;

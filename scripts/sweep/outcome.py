@@ -11,7 +11,8 @@ Kinds (docs/stability-map.md), first match wins:
   runaway leaflet (below);
 - `leaks`: particles crossed a leaflet (fluid_probes.h5 interface/leaks > 0) -- the programs
   count them but do not stop, so a completed run can end in this class;
-- `energy growth`: the interface force beyond any physical bound (|F| > `force_bound`; an
+- `energy growth`: the coupler stopped a runaway interface (coupling.max_interface_speed), or
+  the interface force beyond any physical bound (|F| > `force_bound`; an
   explicit coupling instability and a fluid instability next to the leaflet look alike here:
   the stability map's "window only" group tells them apart), or a leaflet's free edge faster
   than `speed_bound` (10 m/s, 6x the Bernoulli jet speed of the waveform's peak gradient,
@@ -39,6 +40,8 @@ PATTERNS = [  # (kind, regex on a log line), checked on error lines first
     ("time-step collapse", re.compile(r"time step collapsed", re.IGNORECASE)),
     ("solid failure", re.compile(r"inverted|overflow|material", re.IGNORECASE)),
     ("coupling divergence", re.compile(r"diverg|not converged", re.IGNORECASE)),
+    # the coupler's runaway check (coupling.max_interface_speed, docs/coupling.md)
+    ("energy growth", re.compile(r"interface is running away", re.IGNORECASE)),
 ]
 LEAFLET_SPEED = re.compile(r"leaflet node speed ([0-9.eE+-]+) m/s")
 ERROR_LINE = re.compile(r"\[(error|critical)\]|run_case: .*failed|error:", re.IGNORECASE)

@@ -105,6 +105,22 @@ TEST(Launcher, FailingParticipantStopsTheOthersAndItsCodeIsReturned) {
   expect_nothing_left(output);
 }
 
+// The coupler relays the fluid's abort (exit 5, "aborted by a peer") and may exit before the
+// fluid does; the launcher must still name the fluid, the origin, and return its code.
+TEST(Launcher, TheParticipantThatFailedIsNamedNotTheOneRelayingItsAbort) {
+  const auto dir = fresh_directory("launch-relay");
+  const auto output = dir / "run";
+  auto launcher = launch(write_case(dir, "\"--step-seconds\", \"0.02\", \"--fail-at-window\", \"5\"", "\"--step-seconds\", \"0.02\""),
+                         output);
+  const auto code = launcher->wait_for_exit(30s);
+  ASSERT_TRUE(code.has_value()) << launcher->log_text();
+  EXPECT_EQ(*code, 2) << launcher->log_text();
+  EXPECT_NE(launcher->log_text().find("fluid failed with exit code 2"), std::string::npos) << launcher->log_text();
+  EXPECT_EQ(launcher->log_text().find("coupler failed"), std::string::npos) << launcher->log_text();
+  EXPECT_NE(launcher->log_text().find("deliberate failure at window 5"), std::string::npos) << launcher->log_text();
+  expect_nothing_left(output);
+}
+
 TEST(Launcher, FrozenParticipantEndsTheRunAndIsStopped) {
   const auto dir = fresh_directory("launch-frozen");
   const auto output = dir / "run";

@@ -160,6 +160,20 @@ class Classify(unittest.TestCase):
         o = outcome.classify(self.dir, 1, 0.1)
         self.assertEqual((o.kind, o.detected_by), ("coupling divergence", "fluid (time-step guard)"))
 
+    def test_coupler_stops_are_named_by_kind(self):
+        launcher = Path(self.tmp.name) / "launcher.log"
+        launcher.write_text("run_case: coupler failed with exit code 6; stopping fluid, solid\n")
+        write_logs(self.dir, {"coupler": "[error] coupler: implicit window 10 (t = 6.5e-05 s, size 6.5e-06 s) diverged: "
+                                         "relative residual 1.678e+02 after 30 iterations\n",
+                              "fluid": "[error] fluid_sph: participant aborted\n"})
+        o = outcome.classify(self.dir, 6, 0.1, launcher_log=launcher)
+        self.assertEqual((o.kind, o.detected_by), ("coupling divergence", "coupler"))
+        write_logs(self.dir, {"coupler": "[error] coupler: window 4 (t = 2e-05 s to 2.6e-05 s): solid interface node 3 "
+                                         "at (1.000, 2.000, 0.000) mm moves at 31 m/s > coupling.max_interface_speed = "
+                                         "20 m/s: the interface is running away\n"})
+        o = outcome.classify(self.dir, 6, 0.1, launcher_log=launcher)
+        self.assertEqual((o.kind, o.detected_by), ("energy growth", "coupler"))
+
     def test_nan_reported_by_the_coupler(self):
         write_logs(self.dir, {"coupler": "[error] coupler: NaN in 'loads' from participant 'fluid' at point 3\n"})
         self.assertEqual(outcome.classify(self.dir, 5, 0.1).kind, "nan")

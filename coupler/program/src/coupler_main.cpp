@@ -4,6 +4,7 @@
 // Couples the fluid and the solid of a case (its `coupling` part), see docs/coupling.md.
 
 #include <CLI/CLI.hpp>
+#include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
 #include <iostream>
@@ -16,6 +17,8 @@
 #include "valvefsi/coupling/transport_errors.hpp"
 
 int main(int argc, char** argv) {
+  // SPDLOG_LEVEL=debug shows every implicit iteration's residual (docs/coupling.md).
+  spdlog::cfg::load_env_levels();
   CLI::App app{"valvefsi coupler: couples fluid_sph and solid_fe (or any participants) through ZeroMQ"};
   std::string case_file;
   std::string output_dir;

@@ -36,6 +36,7 @@ CouplerSettings settings_from_case(const cases::Case& run_case, const std::files
   }
   settings.acceleration.relaxation = coupling.relaxation_factor();
   settings.acceleration.reused_windows = coupling.iqn_reused_windows();
+  settings.acceleration.filter_epsilon = coupling.iqn_filter_epsilon();
   settings.relative_tolerance = coupling.relative_tolerance();
   settings.absolute_tolerance = coupling.absolute_tolerance();
   settings.max_iterations = coupling.max_iterations();
@@ -57,6 +58,8 @@ CouplerSettings settings_from_case(const cases::Case& run_case, const std::files
   settings.series_flush_rows = coupling.series_flush_rows();
   settings.restart_interval = coupling.restart_interval_s();
   settings.restart_keep = coupling.restart_keep();
+  settings.divergence_residual = coupling.divergence_residual();
+  settings.max_interface_speed = coupling.max_interface_speed();
   return settings;
 }
 

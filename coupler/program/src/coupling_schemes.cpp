@@ -1,5 +1,6 @@
 #include "valvefsi/coupler/coupling_schemes.hpp"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include "valvefsi/coupler/restart_points.hpp"
 #include "valvefsi/coupling/acceleration.hpp"
 #include "valvefsi/coupling/restart_points.hpp"
+#include "valvefsi/coupling/transport_errors.hpp"
 
 namespace valvefsi::coupler {
 
@@ -91,10 +93,21 @@ WindowRecord serial_implicit_window(WindowExchange& exchange, const CouplerSetti
     fill_record(record, window, fluid.forces, fluid_velocities, node_forces, mean_velocities);
     record.iterations = k + 1;
     record.relative_residual = residual;
+    if (k == 0) record.first_residual = record.smallest_residual = residual;
+    record.smallest_residual = std::min(record.smallest_residual, residual);
+    if (!std::isfinite(residual)) {
+      throw coupling::CouplingFailed(fmt::format(
+          "implicit window {} (t = {} s) diverged: the relative residual of iteration {} is not finite; try a "
+          "smaller coupling.window_size or relaxation_factor",
+          window.index, window.time, k + 1));
+    }
     proposals = {fluid.max_stable_window, reply.max_stable_window};
     // Relative to the displacement, or absolute for a solid (nearly) at rest.
     const double rms_change = (output - input).norm() / std::sqrt(static_cast<double>(std::max<Eigen::Index>(output.size() / 3, 1)));
     record.converged = residual < settings.relative_tolerance || rms_change < settings.absolute_tolerance;
+    spdlog::debug("coupler: window {} iteration {}: relative residual {:.6e}, RMS change {:.6e} m, |x| {:.6e} m, "
+                  "|fluid loads| {:.17g} N, |solid output| {:.17g} m",
+                  window.index, k + 1, residual, rms_change, input.norm(), fluid.forces.norm(), output.norm());
     if (record.converged || k + 1 >= settings.max_iterations) {
       acceleration.end_window();
       exchange.send_converged(window.time + window.size, static_cast<std::uint32_t>(k + 1), residual, record.converged);
@@ -106,6 +119,38 @@ WindowRecord serial_implicit_window(WindowExchange& exchange, const CouplerSetti
       return record;
     }
     input = acceleration.next_input(input, output);
+  }
+}
+
+// The failure checks of a completed window (docs/coupling.md, "When the coupling fails").
+void check_window(const WindowRecord& record, const WindowSpan& window, const SolidState& solid,
+                  const CouplerSettings& settings) {
+  if (!record.converged && settings.divergence_residual > 0.0 && record.relative_residual >= settings.divergence_residual) {
+    throw coupling::CouplingFailed(fmt::format(
+        "implicit window {} (t = {} s, size {:.3g} s) diverged: relative residual {:.3e} after {} iterations (first "
+        "{:.3e}, smallest {:.3e}) >= coupling.divergence_residual = {}; try a smaller coupling.window_size, a smaller "
+        "relaxation_factor, fewer iqn_reused_windows or acceleration AITKEN, and check that both solvers restore "
+        "their checkpoints exactly",
+        window.index, window.time, window.size, record.relative_residual, record.iterations, record.first_residual,
+        record.smallest_residual, settings.divergence_residual));
+  }
+  if (settings.max_interface_speed > 0.0 && solid.velocities.cols() > 0) {
+    Eigen::Index node = 0;
+    const double speed = std::sqrt(solid.velocities.colwise().squaredNorm().maxCoeff(&node));
+    if (!(speed <= settings.max_interface_speed)) {
+      const Eigen::Vector3d where = 1e3 * solid.positions.col(node);
+      throw coupling::CouplingFailed(fmt::format(
+          "window {} (t = {} s to {} s): solid interface node {} at ({:.3f}, {:.3f}, {:.3f}) mm moves at {:.3g} m/s > "
+          "coupling.max_interface_speed = {} m/s: the interface is running away. {}; raise max_interface_speed only "
+          "if such speeds are physical",
+          window.index, window.time, window.time + window.size, node, where.x(), where.y(), where.z(), speed,
+          settings.max_interface_speed,
+          settings.scheme == SchemeKind::serial_implicit
+              ? "The implicit iterations did not hold it: try a smaller coupling.window_size or relative_tolerance"
+              : "Under explicit coupling this is the added-mass instability (the leaflet is too light for the window, "
+                "docs/coupling-numerics.md): use a smaller coupling.window_size, scheme SERIAL_IMPLICIT, or a heavier or "
+                "thicker leaflet"));
+    }
   }
 }
 
@@ -181,6 +226,7 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
       spdlog::info("coupler: restart data at t = {} s in {}", window.time, restart.string());
     }
     observe(record);
+    check_window(record, window, solid, settings);
     ++summary.windows;
     summary.total_iterations += record.iterations;
     if (!record.converged) ++summary.unconverged_windows;

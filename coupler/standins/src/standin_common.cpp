@@ -4,6 +4,8 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include "valvefsi/case/case_loader.hpp"
@@ -19,6 +21,8 @@ void add_common_options(CLI::App& app, StandinSettings& settings) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--nan-at-window", settings.nan_at_window, "test: put a NaN into this window's output");
   app.add_option("--exit-at-window", settings.exit_at_window, "test: exit(7) silently at this window");
+  app.add_option("--fail-at-window", settings.fail_at_window,
+                 "test: fail with an error at this window (the others hear an abort; exit code 2)");
 }
 
 coupling::ParticipantOptions participant_options(const StandinSettings& settings, coupling::ParticipantRole role,
@@ -60,6 +64,9 @@ void simulate_step(const StandinSettings& settings, std::uint64_t window_index) 
   if (settings.step_seconds > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(settings.step_seconds));
   if (settings.exit_at_window >= 0 && window_index == static_cast<std::uint64_t>(settings.exit_at_window)) {
     std::_Exit(7);
+  }
+  if (settings.fail_at_window >= 0 && window_index == static_cast<std::uint64_t>(settings.fail_at_window)) {
+    throw std::runtime_error("test: a deliberate failure at window " + std::to_string(window_index));
   }
 }
 

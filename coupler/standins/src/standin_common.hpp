@@ -20,6 +20,7 @@ struct StandinSettings {
   double step_seconds = 0.0;     // wall-clock work per window, to stand in for a real step
   long nan_at_window = -1;       // put a NaN into the output of this window (tests)
   long exit_at_window = -1;      // exit(7) without a word at this window (tests)
+  long fail_at_window = -1;      // fail with an error at this window: abort sent, exit 2 (tests)
 };
 
 // Adds the shared options to `app`.

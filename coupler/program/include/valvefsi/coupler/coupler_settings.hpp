@@ -34,6 +34,9 @@ struct CouplerSettings {
   int restart_keep = 2;
   std::filesystem::path restart_from;   // a complete restart folder (resolve_restart_folder)
   double restart_time = 0.0;            // its time, read from the coupler's restart file
+  // Failure checks (coupling.divergence_residual, coupling.max_interface_speed); 0 = off.
+  double divergence_residual = 1.0;
+  double max_interface_speed = 20.0;  // m/s
 };
 
 // "serial-explicit", "parallel-explicit", "serial-implicit/iqn-ils" (the acceleration is part

@@ -23,6 +23,8 @@ struct WindowRecord {
   std::uint64_t index = 0;
   int iterations = 1;
   double relative_residual = 0.0;   // 0 for explicit schemes
+  double first_residual = 0.0;      // implicit: the residual of the window's first iteration
+  double smallest_residual = 0.0;   // implicit: the smallest over the window's iterations
   bool converged = true;
   Eigen::Vector3d force_fluid = Eigen::Vector3d::Zero();  // sum over the fluid's points (N)
   Eigen::Vector3d force_solid = Eigen::Vector3d::Zero();  // sum over the solid's nodes (N)
@@ -44,7 +46,10 @@ using WindowObserver = std::function<void(const WindowRecord&)>;
 double next_window_size(double time, double end_time, double case_window, double fluid_proposal,
                         double solid_proposal);
 
-// Runs windows from t = 0 to settings.end_time. Throws the transport's errors.
+// Runs windows from t = 0 to settings.end_time. Throws the transport's errors, and
+// coupling::CouplingFailed (after `observe` has seen the window) when an implicit window
+// diverged or the solid's interface ran away (settings.divergence_residual,
+// settings.max_interface_speed).
 SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSettings& settings,
                                   const WindowObserver& observe);
 

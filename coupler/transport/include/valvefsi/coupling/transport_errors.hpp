@@ -14,6 +14,8 @@ enum ExitCode : int {
   kExitPeerLost = 3,       // a peer went silent (died, froze) or disconnected
   kExitProtocolError = 4,  // a malformed message, a version mismatch, an out-of-order message
   kExitAborted = 5,        // a peer aborted the run, or a non-finite value was exchanged
+  kExitCouplingFailed = 6,  // the coupled solution failed a check: a diverged implicit window,
+                            // an interface running away
 };
 
 class TransportError : public std::runtime_error {
@@ -43,6 +45,13 @@ class ProtocolError : public TransportError {
 class RunAborted : public TransportError {
  public:
   explicit RunAborted(const std::string& message) : TransportError(message, kExitAborted) {}
+};
+
+// The coupler stops a run whose coupled solution fails a check (the message names the window,
+// the quantity and what to change); the participants hear it as an abort.
+class CouplingFailed : public TransportError {
+ public:
+  explicit CouplingFailed(const std::string& message) : TransportError(message, kExitCouplingFailed) {}
 };
 
 }  // namespace valvefsi::coupling

@@ -27,8 +27,8 @@ class SlabDecomposition {
   static constexpr int kAxis = D - 1;
   static constexpr int kHaloLayers = 2;
 
-  // Cuts the grid's layers into comm's size slabs of about equal particle counts (mirror
-  // images and lost particles not counted). `particles`: the whole scene, the same on every
+  // Cuts the grid's layers into comm's size slabs of about equal cost (fluid particles 1,
+  // walls 1/4; mirror images and lost particles not counted). `particles`: the whole scene, the same on every
   // rank. Throws std::invalid_argument when a slab would be thinner than the halo (too many
   // ranks for the domain) or the last axis is periodic.
   SlabDecomposition(MPI_Comm comm, const CellGrid<D>& grid, const Particles<D>& particles);

@@ -65,7 +65,8 @@ void write_particle_dump(const std::string& file, const FluidSolver<3>& solver, 
 // The fluid part of a case (e.g. the coupled sector) at rest with the solid's surface at
 // rest in it, for a number of steps: loads at rest, leaks and the cost per step, with and
 // without the surface.
-int run_case_at_rest(const std::string& case_file, const std::string& surface_file, long steps, bool no_surface, bool aligned, bool behind_only) {
+int run_case_at_rest(const std::string& case_file, const std::string& surface_file, long steps, bool no_surface, bool aligned, bool behind_only,
+                     int relax_cycles, long relax_steps) {
   const valvefsi::cases::Case c = valvefsi::load_case(case_file);
   auto setup = fluid_setup_from_case<3>(c, case_file);
   FluidSolver<3> solver = make_solver<3>(std::move(setup));
@@ -80,6 +81,67 @@ int run_case_at_rest(const std::string& case_file, const std::string& surface_fi
     auto m = std::make_unique<ThinWallModel3D>(read_surface(surface_file), fluid, settings);
     model = m.get();
     solver.set_immersed_surface(std::move(m));
+    // Start-up relaxation (experiment): cycles of relax_steps steps at rest, after each of
+    // which every fluid particle keeps its position but loses its velocity and gets its initial
+    // density back, so that the particles next to the leaflet settle where the background
+    // pressure balances.
+    std::vector<float> initial;
+    {
+      const auto& p = solver.particles();
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (p.kind[i] == Kind::fluid) {
+          if (initial.size() <= p.id[i]) initial.resize(p.id[i] + 1, 0.0f);
+          initial[p.id[i]] = p.density_excess[i];
+        }
+    }
+    for (int cycle = 0; cycle < relax_cycles; ++cycle) {
+      for (long k = 0; k < relax_steps; ++k) solver.step();
+      const auto& p = solver.particles();
+      // relax_steps = 0: move every fluid particle down the kernel sum's gradient instead
+      // (needs the case's shifting on for the solver to keep grad C), by 0.25 dp^2 grad C capped
+      // at 0.05 dp, never across or close to the leaflet: the background pressure's force on a
+      // particle is -2 p_b grad C / rho, so this settles the particles where it vanishes.
+      const bool by_gradient = relax_steps == 0 && p.kernel_sum_gradient[0].size() == p.size();
+      const double dp = solver.settings().particle_spacing;
+      double largest_shift = 0;
+      Particles<3> q;
+      double v2 = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const Kind kind = p.kind[i];
+        if (kind != Kind::fluid && kind != Kind::wall) continue;
+        std::array<float, 3> v{p.velocity[0][i], p.velocity[1][i], p.velocity[2][i]};
+        float rho = p.density_excess[i];
+        Vec3 x{p.position[0][i], p.position[1][i], p.position[2][i]};
+        if (kind == Kind::fluid) {
+          v2 = std::max(v2, static_cast<double>(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+          v = {0.0f, 0.0f, 0.0f};
+          rho = initial[p.id[i]];
+          if (by_gradient) {
+            Vec<3> shift;
+            double length = 0;
+            for (int d = 0; d < 3; ++d) {
+              shift[d] = -0.25 * dp * dp * p.kernel_sum_gradient[d][i];
+              length += shift[d] * shift[d];
+            }
+            length = std::sqrt(length);
+            if (length > 0.05 * dp)
+              for (int d = 0; d < 3; ++d) shift[d] *= 0.05 * dp / length;
+            if (solver.immersed_surface()->accept_shift(p, i, shift)) {
+              for (int d = 0; d < 3; ++d) x[d] += shift[d];
+              largest_shift = std::max(largest_shift, std::min(length, 0.05 * dp));
+            }
+          }
+        }
+        q.add(x, v, rho, kind, p.body[i]);
+        q.id.back() = p.id[i];
+      }
+      const Vec3 f = model->total_force();
+      std::printf("relaxation cycle %d: largest speed %.4g m/s, largest shift %.3g dp, net force %.4g %.4g %.4g N before the reset\n",
+                  cycle + 1, std::sqrt(v2), largest_shift / dp, f[0], f[1], f[2]);
+      auto fresh = std::make_unique<ThinWallModel3D>(read_surface(surface_file), fluid, settings);
+      model = fresh.get();
+      solver = FluidSolver<3>(solver.settings(), std::move(q), solver.plates(), std::move(fresh));
+    }
   }
   if (model && solver.particles().kernel_sum.size() == solver.particles().size()) {
     // Kernel completeness next to the leaflet at the start (the case must switch shifting on
@@ -201,10 +263,14 @@ int main(int argc, char** argv) {
   app.add_option("--surface", surface_file, "surface as text (scripts/dump_surface.py), with --case");
   app.add_option("--steps", steps, "steps, with --case");
   bool aligned = false, behind_only = false;
+  int relax_cycles = 0;
+  long relax_steps = 20;
+  app.add_option("--relax-cycles", relax_cycles, "with --case: start-up relaxation cycles (velocities and densities reset after each)");
+  app.add_option("--relax-steps", relax_steps, "with --case: steps per relaxation cycle");
   app.add_flag("--behind-only", behind_only, "virtual lattice behind the tangent plane only");
   app.add_flag("--aligned-layers", aligned, "virtual layers continue the particle's own lattice through the wall");
   CLI11_PARSE(app, argc, argv);
-  if (!case_file.empty()) return run_case_at_rest(case_file, surface_file, steps, no_surface, aligned, behind_only);
+  if (!case_file.empty()) return run_case_at_rest(case_file, surface_file, steps, no_surface, aligned, behind_only, relax_cycles, relax_steps);
 
   ThinWallCase3D c = scene == "two_levels" ? two_level_tank_3d(dp, 0.5, 0.25, width, 0.0, mirror)
                      : scene == "gap"      ? two_level_tank_3d(dp, 0.5, 0.25, width, gap, mirror)

@@ -65,7 +65,11 @@ BACKGROUND_PRESSURE_2D = False
 # 10 N/m lets go near 2.4 mmHg forward (the waveform passes it ~5 ms into ejection, before the
 # FSI valve's inertia lets it move) and holds against the diastolic sloshing dips that lifted
 # the untied tips (docs/fsi-2d.md).
-COAPTATION_TIE = True
+# Off in the cases: tried in session 4 (two 2D xcoarse cycles, docs/comparison.md "Reading this
+# report"), the fluid pulls the tips at 200-230 N/m, 20x the release force, so the tie caught and
+# released them ~1,000-1,800 times per cycle and did not hold the valve shut, while it delayed the
+# FE-only opening (6.8 vs 3.7 ms) and broke the FE-only cycle-to-cycle agreement (11 % vs 2 %).
+COAPTATION_TIE = False
 COAPTATION_TIE_RELEASE_N_PER_M = 10.0
 # Contact plane holding the closed 2D valve (docs/fsi-2d.md).
 ANNULUS_PLANE = "annulus"

@@ -99,8 +99,14 @@ TEST(SceneCaseFiles, TwoDimensionalCasesLoad) {
       const valvefsi::PressureWaveform wf(c.waveform(), name);
       EXPECT_NEAR(wf.aortic_pressure(0.0) + f.plates(1).pressure_mmhg() * valvefsi::kPascalPerMmHg, 0.0, 1.0);
       EXPECT_NEAR(wf.ventricular_pressure(0.0) + f.plates(0).pressure_mmhg() * valvefsi::kPascalPerMmHg, 0.0, 1.0);
-      EXPECT_EQ(f.probes().pressure_points_size(), 2);
-      EXPECT_GE(f.probes().flow_planes_size(), 3);
+      // two taps, each with four more probes across its section (docs/hemodynamics.md), and the
+      // flow sections plus the jet core 15 mm downstream
+      EXPECT_EQ(f.probes().pressure_points_size(), 2 + 2 * 4);
+      EXPECT_GE(f.probes().flow_planes_size(), 4);
+      bool jet_core = false;
+      for (const auto& plane : f.probes().flow_planes())
+        jet_core = jet_core || (plane.name() == "jet_core_15mm" && plane.radius() > 0.0);
+      EXPECT_TRUE(jet_core);
       EXPECT_TRUE(f.has_thin_walls());
       EXPECT_GT(c.coupling().window_size(), 0.0);
       EXPECT_LE(c.coupling().window_size(), 1e-5);

@@ -16,7 +16,6 @@
 
 namespace valvefsi::solid {
 namespace {
-constexpr std::int64_t kMinElementsForThreads = 1000;
 constexpr std::array<std::array<double, 2>, 4> kFaceSigns{{{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}};
 }  // namespace
 
@@ -106,75 +105,25 @@ void HexahedronElements::set_pressure_faces(std::vector<PressureFace> faces) {
 
 InternalForceResult HexahedronElements::internal_force(const Eigen::Matrix3Xd& x, bool estimate_step,
                                                        Eigen::Matrix3Xd& out, Eigen::Matrix3Xd* hourglass) {
-  const int threads = omp_get_max_threads();
-  const Eigen::Index n = model_.reference_positions.cols();
-  if (static_cast<int>(thread_forces_.size()) != threads) {
-    thread_forces_.assign(static_cast<std::size_t>(threads), Eigen::Matrix3Xd::Zero(3, n));
-    thread_hourglass_.assign(static_cast<std::size_t>(threads), Eigen::Matrix3Xd::Zero(3, n));
-  }
   const auto num_elements = static_cast<std::int64_t>(model_.elements.size());
-  double strain_energy = 0.0, hourglass_energy = 0.0;
-  double max_omega2 = 0.0;
-  std::int64_t critical = -1;
-  std::string error;
   const double density = model_.density;
-  std::visit(
+  return std::visit(
       [&](const auto& law) {
-#pragma omp parallel if (num_elements >= kMinElementsForThreads)
-        {
-          const auto t = static_cast<std::size_t>(omp_get_thread_num());
-          Eigen::Matrix3Xd& f = thread_forces_[t];
-          Eigen::Matrix3Xd& fh = thread_hourglass_[t];
-          f.setZero();
-          fh.setZero();
-          double local_energy = 0.0, local_hourglass = 0.0, local_omega2 = 0.0;
-          std::int64_t local_critical = -1;
-#pragma omp for schedule(static)
-          for (std::int64_t e = 0; e < num_elements; ++e) {
-            try {
+        return accumulate_element_forces(
+            "hexahedron", num_elements, [](std::int64_t) {},
+            [&](std::int64_t e, Eigen::Matrix3Xd& f, Eigen::Matrix3Xd& fh) {
               const auto ue = static_cast<std::size_t>(e);
-              const HexElementResult r = hex_element_force(model_.elements[ue], law, x, density, moduli_[ue],
-                                                           estimate_step, f, &fh);
-              local_energy += r.strain_energy;
-              local_hourglass += r.hourglass_energy;
-              if (r.omega2 > local_omega2) {
-                local_omega2 = r.omega2;
-                local_critical = e;
-              }
-            } catch (const MaterialStateError& ex) {
-#pragma omp critical(valvefsi_hex_error)
-              if (error.empty()) error = fmt::format("hexahedron {}: {}", e, ex.what());
-            }
-          }
-#pragma omp critical(valvefsi_hex_reduce)
-          {
-            strain_energy += local_energy;
-            hourglass_energy += local_hourglass;
-            if (local_omega2 > max_omega2) {
-              max_omega2 = local_omega2;
-              critical = local_critical;
-            }
-          }
-        }
+              const HexElementResult r =
+                  hex_element_force(model_.elements[ue], law, x, density, moduli_[ue], estimate_step, f, &fh);
+              // The element's critical step 2 / omega (the same value and element as 2 / sqrt of the
+              // largest omega^2).
+              const double step = estimate_step && r.omega2 > 0.0 ? 2.0 / std::sqrt(r.omega2)
+                                                                  : std::numeric_limits<double>::infinity();
+              return ElementContribution{r.strain_energy, r.hourglass_energy, step};
+            },
+            out, hourglass);
       },
       material_);
-  if (!error.empty()) throw MaterialStateError(error);
-  if (out.cols() != n) out.resize(3, n);
-  out = thread_forces_[0];
-  for (std::size_t t = 1; t < thread_forces_.size(); ++t) out += thread_forces_[t];
-  if (hourglass != nullptr) {
-    if (hourglass->cols() != n) hourglass->resize(3, n);
-    *hourglass = thread_hourglass_[0];
-    for (std::size_t t = 1; t < thread_hourglass_.size(); ++t) *hourglass += thread_hourglass_[t];
-  }
-  InternalForceResult result;
-  result.strain_energy = strain_energy;
-  result.hourglass_energy = hourglass_energy;
-  if (estimate_step && max_omega2 > 0.0) {
-    result.min_step = 2.0 / std::sqrt(max_omega2);
-    result.critical_element = critical;
-  }
-  return result;
 }
 
 void HexahedronElements::add_pressure_force(const Eigen::Matrix3Xd& x, double dp, Eigen::Matrix3Xd& f) const {

@@ -13,10 +13,6 @@
 #include "valvefsi/solid/shell_forces.hpp"
 
 namespace valvefsi::solid {
-namespace {
-constexpr std::int64_t kMinElementsForThreads = 1000;  // below this thread start-up costs more than it saves
-}  // namespace
-
 ShellElements::ShellElements(ShellModel model, Material material)
     : model_(std::move(model)), material_(std::move(material)) {
   set_pressure_elements({});
@@ -45,59 +41,21 @@ void ShellElements::set_pressure_elements(std::vector<std::int64_t> elements) {
 
 InternalForceResult ShellElements::internal_force(const Eigen::Matrix3Xd& x, bool estimate_step,
                                                   Eigen::Matrix3Xd& out, Eigen::Matrix3Xd* /*hourglass*/) {
-  const int threads = omp_get_max_threads();
-  const Eigen::Index n = model_.reference_positions.cols();
-  if (static_cast<int>(thread_forces_.size()) != threads) {
-    thread_forces_.assign(static_cast<std::size_t>(threads), Eigen::Matrix3Xd::Zero(3, n));
-  }
   const auto num_elements = static_cast<std::int64_t>(model_.elements.size());
   hinge_sides_.resize(static_cast<std::size_t>(3 * num_elements));
   HingeSide* sides = hinge_sides_.data();
-  InternalForceResult result;
-  std::string error;
-  std::visit(
+  return std::visit(
       [&](const auto& law) {
-#pragma omp parallel if (num_elements >= kMinElementsForThreads)
-        {
-          Eigen::Matrix3Xd& f = thread_forces_[static_cast<std::size_t>(omp_get_thread_num())];
-          f.setZero();
-          double local_energy = 0.0;
-          double local_step = std::numeric_limits<double>::infinity();
-          std::int64_t local_critical = -1;
-#pragma omp for schedule(static)
-          for (std::int64_t e = 0; e < num_elements; ++e) own_hinge_sides(model_, e, x, sides);
-          // (implicit barrier: every side is ready)
-#pragma omp for schedule(static)
-          for (std::int64_t e = 0; e < num_elements; ++e) {
-            try {
-              const ElementResult r = add_element_internal_force(
-                  model_, model_.elements[static_cast<std::size_t>(e)], law, x, f, estimate_step, sides, e);
-              local_energy += r.strain_energy;
-              if (r.stable_step < local_step) {
-                local_step = r.stable_step;
-                local_critical = e;
-              }
-            } catch (const MaterialStateError& ex) {
-#pragma omp critical(valvefsi_solid_error)
-              if (error.empty()) error = fmt::format("element {}: {}", e, ex.what());
-            }
-          }
-#pragma omp critical(valvefsi_solid_reduce)
-          {
-            result.strain_energy += local_energy;
-            if (local_step < result.min_step) {
-              result.min_step = local_step;
-              result.critical_element = local_critical;
-            }
-          }
-        }
+        return accumulate_element_forces(
+            "element", num_elements, [&](std::int64_t e) { own_hinge_sides(model_, e, x, sides); },
+            [&](std::int64_t e, Eigen::Matrix3Xd& f, Eigen::Matrix3Xd&) {
+              const ElementResult r = add_element_internal_force(model_, model_.elements[static_cast<std::size_t>(e)],
+                                                                 law, x, f, estimate_step, sides, e);
+              return ElementContribution{r.strain_energy, 0.0, r.stable_step};
+            },
+            out, nullptr);
       },
       material_);
-  if (!error.empty()) throw MaterialStateError(error);
-  if (out.cols() != n) out.resize(3, n);
-  out = thread_forces_[0];
-  for (std::size_t t = 1; t < thread_forces_.size(); ++t) out += thread_forces_[t];
-  return result;
 }
 
 void ShellElements::add_pressure_force(const Eigen::Matrix3Xd& x, double dp, Eigen::Matrix3Xd& f) const {

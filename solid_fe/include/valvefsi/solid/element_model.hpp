@@ -5,9 +5,14 @@
 // 8-node brick (hexahedron_elements.hpp); docs/solid_fe.md, "One integrator, two element models".
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#include <fmt/format.h>
+#include <omp.h>
+
+#include "valvefsi/solid/material_error.hpp"
 
 namespace valvefsi::solid {
 
@@ -21,6 +26,16 @@ struct InternalForceResult {
   double min_step = std::numeric_limits<double>::infinity();  // smallest element critical step, no safety (s)
   std::int64_t critical_element = -1;                          // the element that sets it
 };
+
+// One element's share of an internal-force evaluation (its forces go into the thread's arrays).
+struct ElementContribution {
+  double strain_energy = 0;
+  double hourglass_energy = 0;
+  double stable_step = std::numeric_limits<double>::infinity();  // its critical step, no safety (s)
+};
+
+// Below this many elements thread start-up costs more than it saves.
+inline constexpr std::int64_t kMinElementsForThreads = 1000;
 
 class ElementModel {
  public:
@@ -47,6 +62,79 @@ class ElementModel {
                               Eigen::VectorXd& max_principal_log_strain) const = 0;
   // The triangle surface leaflet-leaflet contact works on (shells only; nullptr otherwise).
   virtual const ShellModel* contact_surface() const { return nullptr; }
+
+ protected:
+  // The element loop every family shares: elements in parallel (threads from
+  // kMinElementsForThreads elements on), each thread summing forces into its own arrays, which
+  // are added into `out` (and `hourglass` when given) afterwards. `prepare(e)` runs over all
+  // elements first (a barrier follows: e.g. the shell's shared hinge sides), then
+  // `element(e, forces, hourglass_forces)` returns the element's ElementContribution. A
+  // MaterialStateError is rethrown after the loop as "<what> <e>: <message>" (the first one).
+  template <class Prepare, class Element>
+  InternalForceResult accumulate_element_forces(const char* what, std::int64_t num_elements, Prepare&& prepare,
+                                                Element&& element, Eigen::Matrix3Xd& out, Eigen::Matrix3Xd* hourglass) {
+    const int threads = omp_get_max_threads();
+    const Eigen::Index n = reference_positions().cols();
+    const bool with_hourglass = has_hourglass_forces();
+    if (static_cast<int>(thread_forces_.size()) != threads) {  // (threads that stay idle keep zeros)
+      thread_forces_.assign(static_cast<std::size_t>(threads), Eigen::Matrix3Xd::Zero(3, n));
+      thread_hourglass_.assign(static_cast<std::size_t>(threads),
+                               with_hourglass ? Eigen::Matrix3Xd::Zero(3, n) : Eigen::Matrix3Xd());
+    }
+    InternalForceResult result;
+    std::string error;
+#pragma omp parallel if (num_elements >= kMinElementsForThreads)
+    {
+      const auto t = static_cast<std::size_t>(omp_get_thread_num());
+      Eigen::Matrix3Xd& f = thread_forces_[t];
+      Eigen::Matrix3Xd& fh = thread_hourglass_[t];
+      f.setZero();
+      if (with_hourglass) fh.setZero();
+      double local_energy = 0.0, local_hourglass = 0.0;
+      double local_step = std::numeric_limits<double>::infinity();
+      std::int64_t local_critical = -1;
+#pragma omp for schedule(static)
+      for (std::int64_t e = 0; e < num_elements; ++e) prepare(e);
+      // (implicit barrier: everything prepared)
+#pragma omp for schedule(static)
+      for (std::int64_t e = 0; e < num_elements; ++e) {
+        try {
+          const ElementContribution r = element(e, f, fh);
+          local_energy += r.strain_energy;
+          local_hourglass += r.hourglass_energy;
+          if (r.stable_step < local_step) {
+            local_step = r.stable_step;
+            local_critical = e;
+          }
+        } catch (const MaterialStateError& ex) {
+#pragma omp critical(valvefsi_solid_element_error)
+          if (error.empty()) error = fmt::format("{} {}: {}", what, e, ex.what());
+        }
+      }
+#pragma omp critical(valvefsi_solid_element_reduce)
+      {
+        result.strain_energy += local_energy;
+        result.hourglass_energy += local_hourglass;
+        if (local_step < result.min_step) {
+          result.min_step = local_step;
+          result.critical_element = local_critical;
+        }
+      }
+    }
+    if (!error.empty()) throw MaterialStateError(error);
+    if (out.cols() != n) out.resize(3, n);
+    out = thread_forces_[0];
+    for (std::size_t t = 1; t < thread_forces_.size(); ++t) out += thread_forces_[t];
+    if (hourglass != nullptr && with_hourglass) {
+      if (hourglass->cols() != n) hourglass->resize(3, n);
+      *hourglass = thread_hourglass_[0];
+      for (std::size_t t = 1; t < thread_hourglass_.size(); ++t) *hourglass += thread_hourglass_[t];
+    }
+    return result;
+  }
+
+ private:
+  std::vector<Eigen::Matrix3Xd> thread_forces_, thread_hourglass_;  // per-thread sums, allocated once
 };
 
 }  // namespace valvefsi::solid

@@ -79,7 +79,6 @@ class HexahedronElements final : public ElementModel {
   SolidMaterial material_;
   std::vector<HexModuli> moduli_;  // hourglass moduli per element (the material's small-strain ones)
   std::vector<PressureFace> pressure_faces_;
-  std::vector<Eigen::Matrix3Xd> thread_forces_, thread_hourglass_;
 };
 
 }  // namespace valvefsi::solid

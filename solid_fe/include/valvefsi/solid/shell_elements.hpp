@@ -38,7 +38,6 @@ class ShellElements final : public ElementModel {
   ShellModel model_;
   Material material_;
   std::vector<std::int64_t> pressure_elements_;
-  std::vector<Eigen::Matrix3Xd> thread_forces_;  // per-thread accumulation, allocated once
   std::vector<HingeSide> hinge_sides_;           // 3 per element, refreshed at each evaluation
 };
 

@@ -54,9 +54,14 @@ def find_executable(name, build_dir, role):
             fail(f"{role} executable '{name}' does not exist or is not executable")
         return str(path.resolve())
     if build_dir.is_dir():
-        for candidate in sorted(build_dir.rglob(name)):
-            if candidate.is_file() and os.access(candidate, os.X_OK) and "CMakeFiles" not in candidate.parts:
-                return str(candidate)
+        def in_nested_build_tree(path):
+            # another CMake build tree inside this one (e.g. build/clean/) is not this build
+            return any((parent / "CMakeCache.txt").is_file()
+                       for parent in path.parents if parent != build_dir and build_dir in parent.parents)
+        found = [c for c in build_dir.rglob(name)
+                 if c.is_file() and os.access(c, os.X_OK) and "CMakeFiles" not in c.parts and not in_nested_build_tree(c)]
+        if found:
+            return str(min(found, key=lambda c: (len(c.parts), str(c))))
     found = shutil.which(name)
     if found:
         return found

@@ -7,12 +7,15 @@
 
 #include <cmath>
 #include <cstring>
+#include <random>
 #include <functional>
 #include <memory>
 #include <vector>
 
 #include "valvefsi/fluid/fluid_solver.hpp"
+#include "valvefsi/fluid/cell_grid.hpp"
 #include "valvefsi/fluid/geometry.hpp"
+#include "valvefsi/fluid/interactions.hpp"
 #include "valvefsi/fluid/thin_wall/scenes_2d.hpp"
 #include "valvefsi/fluid/thin_wall/scenes_3d.hpp"
 #include "valvefsi/fluid/thin_wall/thin_wall_model.hpp"
@@ -110,16 +113,16 @@ CoupledFluid<2> plate_run() {
 
 TEST(ThinWallCheckpoint, TwoDimensionalPassAfterRestoreRepeatsTheFirst) { check_repeated_windows<2>(plate_run(), 3); }
 
-// The loads of one step depend continuously on the motion: end positions moved by 64 units in
-// the last place (~1e-16 m) change the node loads of each of three steps by round-off only.
+// The loads of one step depend continuously on the motion: end positions moved by 1 to 64 units
+// in the last place (~1e-18 to 1e-16 m) change the node loads of each of three steps by round-off only.
 // (Over a whole window of ~120 steps the same nudge changes the window-averaged loads by ~1 %:
 // the particles' float state amplifies it, docs/thin-leaflet.md "Coupled runs".)
 TEST(ThinWallCheckpoint, TwoDimensionalStepLoadsAreContinuousInTheMotion) {
   CoupledFluid<2> run = plate_run();
   for (int k = 0; k < 3; ++k) run.pass(k, false, false);
   const double end = 4 * run.window_size;
-  std::vector<std::vector<Vec2>> loads[2];
-  for (int nudge : {0, 64}) {
+  std::vector<std::vector<std::vector<Vec2>>> loads;
+  for (int nudge : {0, 1, 2, 3, 5, 8, 13, 21, 34, 64}) {
     if (nudge == 0) run.solver->save_checkpoint();
     else run.solver->restore_checkpoint();
     std::vector<Vec2> x, v;
@@ -128,23 +131,25 @@ TEST(ThinWallCheckpoint, TwoDimensionalStepLoadsAreContinuousInTheMotion) {
       for (int d = 0; d < 2; ++d)
         for (int u = 0; u < nudge; ++u) xj[d] = std::nextafter(xj[d], 1.0);
     run.solver->immersed_surface()->set_window_target(end, x, v);
+    loads.emplace_back();
     for (int step = 0; step < 3; ++step) {
       run.solver->step();
       std::vector<Vec2> f(run.solver->immersed_surface()->node_count());
       run.solver->immersed_surface()->node_forces(f);
-      loads[nudge == 0 ? 0 : 1].push_back(f);
+      loads.back().push_back(f);
     }
   }
-  for (int step = 0; step < 3; ++step) {
-    double diff = 0.0, norm = 0.0;
-    for (std::size_t j = 0; j < loads[0][step].size(); ++j)
-      for (int d = 0; d < 2; ++d) {
-        diff += std::pow(loads[1][step][j][d] - loads[0][step][j][d], 2);
-        norm += std::pow(loads[0][step][j][d], 2);
-      }
-    ASSERT_GT(norm, 0.0);
-    EXPECT_LT(std::sqrt(diff / norm), 1e-10) << "step " << step;
-  }
+  for (std::size_t k = 1; k < loads.size(); ++k)
+    for (int step = 0; step < 3; ++step) {
+      double diff = 0.0, norm = 0.0;
+      for (std::size_t j = 0; j < loads[0][step].size(); ++j)
+        for (int d = 0; d < 2; ++d) {
+          diff += std::pow(loads[k][step][j][d] - loads[0][step][j][d], 2);
+          norm += std::pow(loads[0][step][j][d], 2);
+        }
+      ASSERT_GT(norm, 0.0);
+      EXPECT_LT(std::sqrt(diff / norm), 1e-10) << "nudge " << k << ", step " << step;
+    }
 }
 
 TEST(ThinWallCheckpoint, TwoDimensionalFirstWindowRepeats) { check_repeated_windows<2>(plate_run(), 0); }
@@ -165,6 +170,71 @@ TEST(ThinWallCheckpoint, ThreeDimensionalPassAfterRestoreRepeatsTheFirst) {
                                               std::make_unique<ThinWallModel3D>(c->surface, c->fluid, c->wall_settings));
   r.targets = [c](double t, std::vector<Vec3>& x, std::vector<Vec3>& v) { c->motion(t, x, v); };
   check_repeated_windows<3>(std::move(r), 2);
+}
+
+// The wall's rates on the fluid barely move when the wall moves by 1 to 16 ulps, also for
+// particles beyond a free end, whose virtual lattice has a column on the ray through the end
+// node: that column's shadow test flipped with round-off (jumps of 5-10 % of the largest
+// acceleration here at every nudge, ~4 % of the 2D valve's loads, issue 8). Two leaflets with
+// four free ends in a lively field. A smaller jump remains (0.2 %, at 2 of the 16 nudges;
+// docs/thin-leaflet.md): the bound is 1 % of the largest acceleration.
+TEST(ThinWallContinuity, RatesAreContinuousInTheWallPositionAtFreeEnds) {
+  FluidSettings<2> s;
+  s.particle_spacing = 0.005;
+  s.sound_speed = 20.0;
+  s.artificial_viscosity = 0.02;
+  s.gravity = {0.0, -9.81};
+  s.domain_lower = {-0.1, -0.1};
+  s.domain_upper = {0.1, 0.1};
+  SceneGeometry<2> scene;
+  scene.fluid.push_back({{-0.05, -0.05}, {0.05, 0.05}, {}, [](const Vec<2>&) { return 0.0; }});
+  Particles<2> base = fill_particles<2>(scene, s);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (std::size_t i = 0; i < base.size(); ++i) {
+    for (int d = 0; d < 2; ++d) {
+      base.position[d][i] += 0.3 * s.particle_spacing * u(rng);  // no lattice symmetry
+      base.velocity[d][i] = 0.2f * u(rng);
+      base.viscous_velocity[d][i] = base.velocity[d][i];
+    }
+    base.density_excess[i] = 2.0f * u(rng);
+  }
+  ImmersedSurfaceGeometry<2> g;
+  g.nodes = {{-0.0301, -0.0199}, {-0.0101, 0.0003}, {-0.0049, 0.0201}, {0.0302, 0.0148}, {0.0099, -0.0152}};
+  g.cells = {0, 1, 1, 2, 3, 4};
+  g.node_thickness.assign(5, 2.5e-4);
+  auto accelerations = [&](int ulps) {
+    Particles<2> p = base;
+    CellGrid<2> grid(s.domain_lower, s.domain_upper, s.support_radius(), s.periodic);
+    grid.wrap_and_mark_lost(p);
+    grid.sort(p);
+    ThinWallModel2D model(g, s, {});
+    std::vector<Vec2> x1 = g.nodes, v1(g.nodes.size(), Vec2{0.0, 0.0});
+    for (auto& x : x1)
+      for (int d = 0; d < 2; ++d)
+        for (int k = 0; k < ulps; ++k) x[d] = std::nextafter(x[d], 1.0);
+    model.set_window_target(0.002, x1, v1);
+    model.move_to(0.002);
+    model.classify(p);
+    update_fluid_pressure<2>(p, s);
+    model.update_surface_states(p, grid);
+    for (int d = 0; d < 2; ++d) std::fill(p.acceleration[d].begin(), p.acceleration[d].end(), 0.0f);
+    model.add_surface_rates(p);
+    std::vector<double> a(2 * p.size());  // by particle id
+    for (std::size_t i = 0; i < p.size(); ++i)
+      for (int d = 0; d < 2; ++d) a[2 * p.id[i] + static_cast<std::size_t>(d)] = p.acceleration[d][i];
+    return a;
+  };
+  const auto a0 = accelerations(0);
+  double scale = 0.0;
+  for (const double v : a0) scale = std::max(scale, std::abs(v));
+  ASSERT_GT(scale, 0.0);
+  for (int ulps = 1; ulps <= 16; ++ulps) {
+    const auto a = accelerations(ulps);
+    double worst = 0.0;
+    for (std::size_t k = 0; k < a.size(); ++k) worst = std::max(worst, std::abs(a[k] - a0[k]));
+    EXPECT_LT(worst, 1e-2 * scale) << ulps << " ulps";
+  }
 }
 
 }  // namespace

@@ -44,7 +44,8 @@ PATTERNS = [  # (kind, regex on a log line), checked on error lines first
     ("energy growth", re.compile(r"interface is running away", re.IGNORECASE)),
 ]
 LEAFLET_SPEED = re.compile(r"leaflet node speed ([0-9.eE+-]+) m/s")
-ERROR_LINE = re.compile(r"\[(error|critical)\]|run_case: .*failed|error:", re.IGNORECASE)
+# "[error]" (spdlog's default pattern: fluid_sph, solid_fe) or "12:00:00.000 error" (the coupler's)
+ERROR_LINE = re.compile(r"\[(error|critical)\]|^[0-9:.]+ (error|critical) |run_case: .*failed|error:", re.IGNORECASE)
 
 
 @dataclass

@@ -84,5 +84,52 @@ class TimeStepCollapse(unittest.TestCase):
             self.assertGreater(f["time"][-1], 0.0)
 
 
+class ExplicitRunaway(unittest.TestCase):
+    """A leaflet ten times lighter (110 kg/m^3: added-mass number mu = 10, five times the serial
+    explicit limit of the acoustic piston, docs/coupling-numerics.md) under serial explicit
+    coupling: the interface runs away within a fraction of a millisecond (measured: a node at
+    30.7 m/s in window 58, t = 0.38 ms). The coupler must stop the run itself
+    (coupling.max_interface_speed) naming the window, the node, where it is and the remedy, before
+    the fluid's time-step guard or a NaN; its implicit counterpart, a diverged implicit window, is
+    tested on the piston model problems (tests/coupler)."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory(prefix="sweep-runaway-")
+        cls.work = Path(cls.tmp.name)
+        cls.cost, cls.wall = run_scene(cls.work, {"leaflet_density": 110.0}, 0.002)
+        cls.run_dir = cls.work / "run"
+        cls.coupler_log = (cls.run_dir / "coupler.log").read_text()
+        cls.match = re.search(r"window (\d+) \(t = ([0-9.eE+-]+) s to ([0-9.eE+-]+) s\): solid interface node \d+ at "
+                              r"\([-0-9., ]+\) mm moves at ([0-9.eE+-]+) m/s > coupling.max_interface_speed = 20 m/s",
+                              cls.coupler_log)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_the_coupler_stops_the_run_with_its_own_code(self):
+        self.assertEqual(self.cost.exit_code, 6, self.coupler_log[-2000:])
+        self.assertFalse(self.cost.timed_out)
+        for role in ("fluid", "solid"):
+            self.assertIn("the interface is running away", (self.run_dir / f"{role}.log").read_text(),
+                          f"{role} did not relay the cause")
+
+    def test_message_names_window_node_speed_and_remedy(self):
+        self.assertIsNotNone(self.match, self.coupler_log[-2000:])
+        self.assertGreater(float(self.match.group(4)), 20.0)
+        self.assertLess(float(self.match.group(3)), 0.002)
+        for words in ("added-mass instability", "smaller coupling.window_size", "SERIAL_IMPLICIT"):
+            self.assertIn(words, self.coupler_log)
+        o = outcome.classify(self.run_dir, self.cost.exit_code, 0.002, launcher_log=self.work / "launcher.log")
+        self.assertEqual((o.kind, o.detected_by), ("energy growth", "coupler"))
+
+    def test_the_window_that_ran_away_is_the_last_in_the_series(self):
+        self.assertIsNotNone(self.match, self.coupler_log[-2000:])
+        with h5py.File(self.run_dir / "coupling_series.h5", "r") as f:
+            self.assertEqual(int(f["window_index"][-1]), int(self.match.group(1)))
+            self.assertTrue(np.all(np.isfinite(f["force_fluid"][...])))
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -163,12 +163,12 @@ class Classify(unittest.TestCase):
     def test_coupler_stops_are_named_by_kind(self):
         launcher = Path(self.tmp.name) / "launcher.log"
         launcher.write_text("run_case: coupler failed with exit code 6; stopping fluid, solid\n")
-        write_logs(self.dir, {"coupler": "[error] coupler: implicit window 10 (t = 6.5e-05 s, size 6.5e-06 s) diverged: "
+        write_logs(self.dir, {"coupler": "08:21:39.928 error coupler: implicit window 10 (t = 6.5e-05 s, size 6.5e-06 s) diverged: "
                                          "relative residual 1.678e+02 after 30 iterations\n",
                               "fluid": "[error] fluid_sph: participant aborted\n"})
         o = outcome.classify(self.dir, 6, 0.1, launcher_log=launcher)
         self.assertEqual((o.kind, o.detected_by), ("coupling divergence", "coupler"))
-        write_logs(self.dir, {"coupler": "[error] coupler: window 4 (t = 2e-05 s to 2.6e-05 s): solid interface node 3 "
+        write_logs(self.dir, {"coupler": "08:21:39.928 error coupler: window 4 (t = 2e-05 s to 2.6e-05 s): solid interface node 3 "
                                          "at (1.000, 2.000, 0.000) mm moves at 31 m/s > coupling.max_interface_speed = "
                                          "20 m/s: the interface is running away\n"})
         o = outcome.classify(self.dir, 6, 0.1, launcher_log=launcher)

@@ -57,6 +57,14 @@ class Outcome:
     unconverged_windows: int = 0
 
 
+def _shortened(line: str, keep: int = 400) -> str:
+    """An error line for the table: its start (what failed) and its end (the remedy)."""
+    line = line.strip()
+    if len(line) <= keep:
+        return line
+    return line[: keep // 2] + " ... " + line[-(keep // 2 - 5):]
+
+
 def _lines(path: Path) -> list[str]:
     try:
         return path.read_text(errors="replace").splitlines()
@@ -114,15 +122,15 @@ def classify(run_dir: Path, exit_code: int, end_time: float, timed_out: bool = F
                     if kind == "time-step collapse" and speed and float(speed.group(1)) > speed_bound:
                         # the step collapsed because the solid's motion ran away (an implicit
                         # iterate, an explicit blow-up): the coupling diverged, the guard caught it
-                        return Outcome("coupling divergence", line.strip()[-400:], f"{role} (time-step guard)",
+                        return Outcome("coupling divergence", _shortened(line), f"{role} (time-step guard)",
                                        reached, unconverged)
-                    return Outcome(kind, line.strip()[-400:], role, reached, unconverged)
+                    return Outcome(kind, _shortened(line), role, reached, unconverged)
         if timed_out:
             return Outcome("timeout", f"stopped at the wall-time limit at t = {reached}", "", reached, unconverged)
         if force_max is not None and force_max > force_bound:
             return Outcome("energy growth", f"|interface force| reached {force_max:.3g} N/m "
                            f"(exit code {exit_code}, no program named it)", "", reached, unconverged)
-        detail = errors[0][1].strip()[-400:] if errors else f"exit code {exit_code}, no error line in the logs"
+        detail = _shortened(errors[0][1]) if errors else f"exit code {exit_code}, no error line in the logs"
         return Outcome("other", detail, errors[0][0] if errors else "", reached, unconverged)
 
     if reached is None or reached < end_time - 1e-9:

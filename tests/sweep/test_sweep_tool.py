@@ -154,6 +154,15 @@ class Classify(unittest.TestCase):
         self.assertEqual((o.kind, o.detected_by), ("time-step collapse", "fluid"))
         self.assertAlmostEqual(o.reached_s, 0.02)
 
+    def test_a_long_message_keeps_what_failed_and_the_remedy(self):
+        where = "; ".join(f"particle {k} at (x = {k}.0, 0.0)" for k in range(40))
+        write_logs(self.dir, {"fluid": f"[error] fluid_sph: time step collapsed at t = 0.015 s: {where}; raise the sound speed\n"})
+        o = outcome.classify(self.dir, 1, 0.1)
+        self.assertEqual(o.kind, "time-step collapse")
+        self.assertIn("time step collapsed", o.detail)
+        self.assertIn("raise the sound speed", o.detail)
+        self.assertLessEqual(len(o.detail), 400)
+
     def test_collapse_after_a_runaway_leaflet_is_coupling_divergence(self):
         write_logs(self.dir, {"fluid": "[error] fluid_sph: time step collapsed at t = 3.9e-05 s: dt = 1.28e-08 s; "
                                        "limits: largest fluid speed 169 m/s, leaflet node speed 2.04e+04 m/s\n"})

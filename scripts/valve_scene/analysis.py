@@ -145,16 +145,21 @@ def bisection_profile(nodes: np.ndarray, triangles: np.ndarray, azimuth_deg: flo
     return np.stack([xyz @ direction, xyz[:, 2]], axis=1)
 
 
+VALVE_EVENTS_SMOOTHING_S = 1.0e-3   # Gaussian sigma: removes the FE-only flutter (periods 1-3 ms)
+
+
 @dataclass(frozen=True)
 class ValveEvents:
-    """Times (s) from the free-edge radial-position curve; levels are fractions of its range."""
-    opening_start: float   # first upward crossing of the low level
-    opening_end: float     # first upward crossing of the high level after it
-    closing_start: float   # last downward crossing of the high level
-    closing_end: float     # first downward crossing of the low level after it
-    rvot: float            # rapid valve opening time = opening_end - opening_start
-    rvct: float            # rapid valve closing time = closing_end - closing_start
+    """Times (s) from the free-edge radial-position curve (definitions: valve_events)."""
+    opening_start: float   # the steepest-rise tangent leaves the closed level
+    opening_end: float     # ... and reaches the open level
+    closing_start: float   # the steepest-fall tangent leaves the open level
+    closing_end: float     # ... and reaches the closed level
+    rvot: float            # rapid valve opening time = (r_open - r_closed) / steepest rise
+    rvct: float            # rapid valve closing time = (r_open - r_closed) / steepest fall
     et: float              # ejection time = closing_end - opening_start
+    r_closed: float = float("nan")   # the cycle's closed and open levels (m)
+    r_open: float = float("nan")
 
 
 def _crossings(t: np.ndarray, r: np.ndarray, level: float, upward: bool) -> np.ndarray:
@@ -166,41 +171,81 @@ def _crossings(t: np.ndarray, r: np.ndarray, level: float, upward: bool) -> np.n
     return t[idx] + frac * (t[idx + 1] - t[idx])
 
 
-def valve_events(t, radial_position, low: float = 0.1, high: float = 0.9) -> ValveEvents:
-    """RVOT, RVCT, ET over one cycle of the free-edge radial position r(t).
-    With r_closed = min r and r_open = the median of the samples above r_closed + half the
-    range (the open plateau, so that an opening overshoot or flutter does not move the
-    levels), L = r_closed + low (r_open - r_closed) and H = r_closed + high (r_open - r_closed):
-    opening runs from the first upward crossing of L to
-    the next upward crossing of H; closing from the last downward crossing of H to the next
-    downward crossing of L (so rebounds after closure that stay below H do not count);
-    ejection from opening start to closing end. Crossing times are interpolated linearly."""
+def smoothed(t: np.ndarray, r: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """r(t) resampled (linearly) on a uniform grid no coarser than sigma / 5 and convolved with a
+    Gaussian of standard deviation sigma (the ends continued by their values); returns (t, r)."""
+    spacing = float(np.median(np.diff(t)))
+    if sigma > 0:
+        spacing = min(spacing, sigma / 5.0)
+    grid = np.linspace(t[0], t[-1], int(round((t[-1] - t[0]) / spacing)) + 1)
+    values = np.interp(grid, t, r)
+    if sigma <= 0:
+        return grid, values
+    half = int(math.ceil(4.0 * sigma / (grid[1] - grid[0])))
+    kernel = np.exp(-0.5 * (np.arange(-half, half + 1) * (grid[1] - grid[0]) / sigma) ** 2)
+    padded = np.concatenate([np.full(half, values[0]), values, np.full(half, values[-1])])
+    return grid, np.convolve(padded, kernel / kernel.sum(), mode="valid")
+
+
+def valve_events(t, radial_position, smoothing_s: float = VALVE_EVENTS_SMOOTHING_S) -> ValveEvents:
+    """RVOT, RVCT, ET over one cycle of the free-edge radial position r(t) (docs/valve-scene.md,
+    "Analysis"; the reference: "from the high positive/negative slope of the radial displacement
+    curve", after Leyh et al. 1999).
+    1. r is smoothed by a Gaussian of sigma = smoothing_s (the undamped FE-only leaflet flutters
+       by +-1-2 mm at 1-3 ms periods; a step becomes a ramp of 2.5 sigma under the definition).
+    2. The cycle's own levels: r_closed and r_open, the medians of the smoothed samples below and
+       above the middle of its range (a cycle that starts ajar, an overshoot, rebounds and
+       flutter do not move them); dr = r_open - r_closed.
+    3. The opening is around the first upward crossing of r_closed + dr/2, the closing around the
+       last downward one; each phase is bracketed by the 10 % and 90 % levels around it, and in
+       it the steepest slope g of the smoothed curve is found.
+    4. The tangent at the steepest point leaves one level and reaches the other: RVOT = dr / g
+       (rise), RVCT = dr / |g| (fall); ET runs from the opening tangent's foot on r_closed to the
+       closing tangent's foot on r_closed. On a piecewise-linear history these are its corners."""
     t = np.asarray(t, dtype=float)
     r = np.asarray(radial_position, dtype=float)
     if t.ndim != 1 or t.shape != r.shape or len(t) < 3 or np.any(np.diff(t) <= 0):
         raise ValueError("valve_events: t and radial_position must be 1-D, equally long (>= 3) and t increasing")
-    r_min, r_max = r.min(), r.max()
-    if not r_max > r_min:
+    if not r.max() > r.min():
         raise ValueError("valve_events: the radial position never changes; the valve did not open")
-    r_open = float(np.median(r[r > r_min + 0.5 * (r_max - r_min)]))
-    lo, hi = r_min + low * (r_open - r_min), r_min + high * (r_open - r_min)
-    up_lo = _crossings(t, r, lo, True)
-    if len(up_lo) == 0:
-        raise ValueError(f"valve_events: r(t) never rises through {low:.0%} of its range (starts open?)")
-    opening_start = up_lo[0]
-    up_hi = _crossings(t, r, hi, True)
-    up_hi = up_hi[up_hi > opening_start]
-    down_hi = _crossings(t, r, hi, False)
-    down_lo = _crossings(t, r, lo, False)
-    if len(up_hi) == 0 or len(down_hi) == 0:
+    ts, rs = smoothed(t, r, smoothing_s)
+    middle = 0.5 * (rs.min() + rs.max())
+    r_closed, r_open = float(np.median(rs[rs < middle])), float(np.median(rs[rs >= middle]))
+    span = r_open - r_closed
+    half, low, high = r_closed + 0.5 * span, r_closed + 0.1 * span, r_closed + 0.9 * span
+    slope = np.gradient(rs, ts)
+    ups = _crossings(ts, rs, half, True)
+    if len(ups) == 0:
+        raise ValueError("valve_events: r(t) never rises through half of its range (starts open?)")
+    downs = _crossings(ts, rs, half, False)
+    downs = downs[downs > ups[0]]
+    if len(downs) == 0:
         raise ValueError("valve_events: r(t) does not open and close within the samples given")
-    opening_end, closing_start = up_hi[0], down_hi[-1]
-    down_lo = down_lo[down_lo > closing_start]
-    if len(down_lo) == 0:
-        raise ValueError(f"valve_events: r(t) does not fall below {low:.0%} of its range after closing starts")
-    closing_end = down_lo[0]
-    return ValveEvents(opening_start, opening_end, closing_start, closing_end,
-                       opening_end - opening_start, closing_end - closing_start, closing_end - opening_start)
+    rise_at, fall_at = ups[0], downs[-1]
+
+    def bracket(centre, before_level, before_up, after_level, after_up):
+        before = _crossings(ts, rs, before_level, before_up)
+        before = before[before < centre]
+        after = _crossings(ts, rs, after_level, after_up)
+        after = after[after > centre]
+        lo = before[-1] if len(before) else ts[0]
+        hi = after[0] if len(after) else ts[-1]
+        return (ts >= lo) & (ts <= hi)
+
+    rising = bracket(rise_at, low, True, high, True)
+    k = int(np.flatnonzero(rising)[np.argmax(slope[rising])])
+    g_up = float(slope[k])
+    opening_start = ts[k] - (rs[k] - r_closed) / g_up
+    opening_end = ts[k] + (r_open - rs[k]) / g_up
+    falling = bracket(fall_at, high, False, low, False)
+    k = int(np.flatnonzero(falling)[np.argmin(slope[falling])])
+    g_down = -float(slope[k])
+    if not (g_up > 0 and g_down > 0):
+        raise ValueError("valve_events: no rising or falling slope found around the opening or closing")
+    closing_start = ts[k] - (r_open - rs[k]) / g_down
+    closing_end = ts[k] + (rs[k] - r_closed) / g_down
+    return ValveEvents(float(opening_start), float(opening_end), float(closing_start), float(closing_end),
+                       span / g_up, span / g_down, float(closing_end - opening_start), r_closed, r_open)
 
 
 def kinematics(times, node_history, triangles, midpoint_ids, annulus_radius, sector: bool = False,

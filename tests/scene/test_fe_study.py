@@ -1,4 +1,5 @@
 """The FE-only study's analysis on a synthetic run folder in solid_fe's output layout."""
+import math
 import tempfile
 import unittest
 from pathlib import Path
@@ -11,6 +12,12 @@ from valve_scene.valve_mesh import build_valve_mesh
 from valve_scene.write_cases import CaseSpec
 
 R = 11.5e-3
+
+
+def SMOOTHED_RAMP(duration, sigma=1e-3):
+    """What valve_events reads for a linear ramp of `duration` (its steepest slope after the
+    Gaussian smoothing is reduced by erf(duration / (2 sqrt(2) sigma)))."""
+    return duration / math.erf(duration / (2 * math.sqrt(2) * sigma))
 
 
 def opening_fraction(t):
@@ -73,9 +80,9 @@ class FeStudyAnalysis(unittest.TestCase):
             result = analyse(spec, run, cycle=2, wall_time_s=12.0)
             self.assertIsNotNone(result.events, result.events_error)
             # r is linear in the opening fraction: 10-90 % of a 5 ms and a 10 ms ramp
-            self.assertAlmostEqual(result.events.rvot, 0.8 * 0.005, delta=1e-6)
-            self.assertAlmostEqual(result.events.rvct, 0.8 * 0.010, delta=1e-6)
-            self.assertAlmostEqual(result.events.et, (0.230 + 0.9 * 0.010) - 0.1 * 0.005, delta=1e-6)
+            self.assertAlmostEqual(result.events.rvot, SMOOTHED_RAMP(0.005), delta=1e-6)
+            self.assertAlmostEqual(result.events.rvct, SMOOTHED_RAMP(0.010), delta=1e-6)
+            self.assertAlmostEqual(result.events.et, 0.235 + SMOOTHED_RAMP(0.010) / 2 - (0.0025 - SMOOTHED_RAMP(0.005) / 2), delta=1e-5)
             peak, when = result.peaks["opening/max_principal_log_strain"]
             self.assertEqual(peak.region, "commissure")
             self.assertAlmostEqual(peak.value, 0.2 * pattern_max * (0.2 + 0.8), delta=1e-12)  # fully open
@@ -83,7 +90,7 @@ class FeStudyAnalysis(unittest.TestCase):
             self.assertIn(0.0, result.profiles)
             write_report([result], run / "report.md", run / "figures")
             text = (run / "report.md").read_text()
-            self.assertIn("| fe-ogden-sector-coarse | 4.0 | 8.0 |", text)
+            self.assertIn("| fe-ogden-sector-coarse | 5.1 | 10.0 | 240.0 |", text)
             self.assertTrue((run / "figures" / "fe-only-fe-ogden-sector-kinematics.png").exists())
 
 
@@ -127,9 +134,9 @@ class FeStudyWindows(unittest.TestCase):
             write_fake_run(closing, spec, CLOSING_WINDOW[1] - CLOSING_WINDOW[0], window_fraction(CLOSING_WINDOW[0]))
             result = analyse_windows(spec, opening, closing)
             self.assertIsNotNone(result.events, result.events_error)
-            self.assertAlmostEqual(result.events.rvot, 0.8 * 0.005, delta=1e-6)
-            self.assertAlmostEqual(result.events.rvct, 0.8 * 0.010, delta=1e-6)
-            self.assertAlmostEqual(result.events.et, (0.230 + 0.9 * 0.010) - 0.1 * 0.005, delta=1e-6)
+            self.assertAlmostEqual(result.events.rvot, SMOOTHED_RAMP(0.005), delta=1e-6)
+            self.assertAlmostEqual(result.events.rvct, SMOOTHED_RAMP(0.010), delta=1e-6)
+            self.assertAlmostEqual(result.events.et, 0.235 + SMOOTHED_RAMP(0.010) / 2 - (0.0025 - SMOOTHED_RAMP(0.005) / 2), delta=1e-5)
             self.assertIn("closed/max_principal_log_strain", result.robust_peaks)
             self.assertAlmostEqual(result.peaks["closed/max_principal_log_strain"][1], 0.30, delta=1e-9)
         # the window's case: the waveform rotated to start at the window's cycle time

@@ -1,6 +1,7 @@
 """One run's report (kinematics + hemodynamics) on a synthetic 2D run folder in the solvers'
-layouts: a linear opening over 0-5 ms and closing over 230-240 ms of each cycle give RVOT 4 ms,
-RVCT 8 ms, ET 238.5 ms (10 % / 90 % levels); the probe series of test_hemodynamics gives its EOA."""
+layouts: a linear opening over 0-5 ms and closing over 230-240 ms of each cycle give RVOT 5.1 ms,
+RVCT 10.0 ms, ET 240.0 ms (steepest-slope tangents of the 1 ms-smoothed curve); the probe series of
+test_hemodynamics gives its EOA."""
 import tempfile
 import unittest
 from pathlib import Path
@@ -58,9 +59,10 @@ class RunReport(unittest.TestCase):
             text = run_report(folder, "FSI-2D", cycle=2, dimension=2, out=folder / "report.md")
             self.assertTrue((folder / "report-kinematics.png").exists())
             self.assertTrue((folder / "report-hemodynamics.png").exists())
-        self.assertIn("| RVOT | 4.0 |", text)
-        self.assertIn("| RVCT | 8.0 |", text)
-        self.assertIn("| ET | 238.5 |", text)
+        # the ramps read as D / erf(D / (2 sqrt(2) sigma)) after the 1 ms smoothing (valve_events)
+        self.assertIn("| RVOT | 5.1 |", text)
+        self.assertIn("| RVCT | 10.0 |", text)
+        self.assertIn("| ET | 240.0 |", text)
         self.assertIn("peak 23.00 mm", text)
         eoa = hd.analyse_cycle(th.synthetic(dimension=2), closure_time_s=0.239).eoa
         self.assertIn(f"| EOA (cm per cm depth) | {eoa:.2f} |", text)

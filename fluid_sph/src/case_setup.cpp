@@ -7,6 +7,7 @@
 
 #include "valvefsi/case/case_loader.hpp"
 #include "valvefsi/case/pressure_waveform.hpp"
+#include "valvefsi/fluid/mirror_group.hpp"
 
 namespace valvefsi::fluid {
 namespace {
@@ -115,7 +116,29 @@ FluidSetup<D> fluid_setup_from_case(const cases::Case& c, const std::filesystem:
     plane.normal = in.direction<D>(in.vec<D>(f.mirror_planes(k).normal(), field + ".normal"), field + ".normal");
     s.mirror_planes.push_back(plane);
   }
+  if (s.mirror_planes.size() > 1) {
+    try {
+      (void)compound_mirror_maps<D>(s.mirror_planes);
+    } catch (const std::invalid_argument& e) {
+      in.fail("mirror_planes", fmt::format("({} planes): {}", s.mirror_planes.size(), e.what()));
+    }
+  }
   setup.scene.lattice_origin = in.vec_or<D>(f.lattice_origin(), "lattice_origin", Vec<D>{});
+  if (f.fill_lattice() == cases::FluidCase::HEX_PRISM) {
+    if (D != 3) in.fail("fill_lattice", fmt::format("= HEX_PRISM with run.dimension = {}: allowed only CUBIC in 2D", D));
+    setup.scene.lattice = FillLattice::hex_prism;
+    if (f.lattice_axis().empty()) in.fail("lattice_axis", "is missing: fill_lattice HEX_PRISM needs the axis its layers stack along");
+    if (f.lattice_row_direction().empty())
+      in.fail("lattice_row_direction", "is missing: fill_lattice HEX_PRISM needs the direction of one family of rows");
+    setup.scene.lattice_axis = in.direction<D>(in.vec<D>(f.lattice_axis(), "lattice_axis"), "lattice_axis");
+    setup.scene.lattice_row_direction =
+        in.direction<D>(in.vec<D>(f.lattice_row_direction(), "lattice_row_direction"), "lattice_row_direction");
+    if (const std::string why = fill_lattice_mismatch<D>(setup.scene, s); !why.empty())
+      in.fail("fill_lattice", "= HEX_PRISM: " + why);
+  } else if (!f.lattice_axis().empty() || !f.lattice_row_direction().empty()) {
+    in.fail(f.lattice_axis().empty() ? "lattice_row_direction" : "lattice_axis",
+            "is given, but fill_lattice is CUBIC: allowed only with fill_lattice HEX_PRISM");
+  }
   setup.wall_layers = f.wall_layers();
 
   for (int k = 0; k < f.fluid_blocks_size(); ++k) {

@@ -70,6 +70,13 @@ FluidSolver<D>::FluidSolver(const FluidSettings<D>& settings, Particles<D> parti
       throw std::invalid_argument("fluid settings: a mirror plane's normal has length " + std::to_string(std::sqrt(length2)) +
                                   ": allowed 1 (normalise it)");
   }
+  if (settings_.mirror_images_of_images) {
+    try {
+      compound_mirror_maps_ = compound_mirror_maps<D>(settings_.mirror_planes);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("fluid settings: mirror_planes: ") + e.what());
+    }
+  }
   refresh_mirror_images();
   lost_ = grid_.wrap_and_mark_lost(particles_);
   grid_.sort(particles_);
@@ -189,6 +196,32 @@ void FluidSolver<D>::add_mirror_images() {
         inside = inside && (settings_.periodic[d] || (x[d] >= lower[d] && x[d] < upper[d]));
       }
       if (!inside) continue;  // outside the domain: no neighbour of anything inside it
+      p.add(x, v, p.density_excess[i], k == Kind::fluid ? Kind::mirror_fluid : Kind::mirror_wall, p.body[i]);
+    }
+  }
+  // Images of images (rotations and the other reflections of the planes' group): only those
+  // within a support of every plane's fluid side can be a neighbour of a fluid particle.
+  for (const auto& map : compound_mirror_maps_) {
+    for (std::size_t i = 0; i < kept; ++i) {
+      const Kind k = p.kind[i];
+      if (k != Kind::fluid && k != Kind::wall) continue;
+      Vec<D> x0, v0;
+      for (int d = 0; d < D; ++d) {
+        x0[d] = p.position[d][i];
+        v0[d] = p.velocity[d][i];
+      }
+      const Vec<D> x = map.apply(x0);
+      bool near = true;
+      for (const auto& plane : settings_.mirror_planes) {
+        double distance = 0;
+        for (int d = 0; d < D; ++d) distance += (x[d] - plane.point[d]) * plane.normal[d];
+        near = near && distance > -support;
+      }
+      for (int d = 0; d < D && near; ++d) near = settings_.periodic[d] || (x[d] >= lower[d] && x[d] < upper[d]);
+      if (!near) continue;
+      const Vec<D> u = map.rotate(v0);
+      std::array<float, D> v{};
+      for (int d = 0; d < D; ++d) v[d] = static_cast<float>(u[d]);
       p.add(x, v, p.density_excess[i], k == Kind::fluid ? Kind::mirror_fluid : Kind::mirror_wall, p.body[i]);
     }
   }

@@ -96,5 +96,70 @@ TEST(CaseSetup, MirrorPlanesAreReadNormalisedAndChecked) {
   }
 }
 
+
+// A small 3D sector wedge: fill_lattice HEX_PRISM with the sector's two planes sets up; a plane
+// off the rows, the lattice in 2D and planes whose wedge is not 180/n degrees are refused by name.
+const std::string kWedge = R"(
+run { end_time: 0.1 dimension: 3 }
+fluid {
+  particle_spacing: 0.001
+  domain_lower: [-0.004, -0.004, 0]
+  domain_upper: [0.016, 0.016, 0.01]
+  periodic: [false, false, true]
+  mirror_planes { point: [0, 0, 0] normal: [0, 1, 0] }
+  mirror_planes { point: [0, 0, 0] normal: [0.866025403784439, -0.5, 0] }
+  fill_lattice: HEX_PRISM
+  lattice_axis: [0, 0, 2]
+  lattice_row_direction: [1, 0, 0]
+  walls { tube { origin: [0, 0, -1] axis: [0, 0, 1] length: 2 radius: 0.01 } }
+  fluid_blocks { box { lower: [-1, -1, -1] upper: [1, 1, 1] } }
+}
+)";
+
+std::string setup_error_3d(const std::string& text) {
+  try {
+    fluid_setup_from_case<3>(parse_case_text(text, "wedge.textproto"), "wedge.textproto");
+  } catch (const CaseError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(CaseSetup, HexPrismFillIsReadAndChecked) {
+  const FluidSetup<3> setup = fluid_setup_from_case<3>(parse_case_text(kWedge, "wedge.textproto"), "wedge.textproto");
+  EXPECT_EQ(setup.scene.lattice, FillLattice::hex_prism);
+  EXPECT_DOUBLE_EQ(setup.scene.lattice_axis[2], 1.0);
+  FluidSolver<3> solver = make_solver<3>(setup);
+  // 10 layers of the 60-degree wedge of radius 10 dp: about pi 10^2 / 6 = 52 particles a layer.
+  EXPECT_NEAR(static_cast<double>(solver.particles().count(Kind::fluid)) / 10.0, 52.4, 4.0);
+
+  std::string off_rows = kWedge;
+  off_rows.replace(off_rows.find("lattice_row_direction: [1, 0, 0]"), 32, "lattice_row_direction: [1, 1, 0]");
+  std::string what = setup_error_3d(off_rows);
+  EXPECT_NE(what.find("wedge.textproto: field 'fluid.fill_lattice' = HEX_PRISM: mirror_planes[0] does not run along a row"),
+            std::string::npos) << what;
+
+  std::string shifted = kWedge;
+  shifted.replace(shifted.find("point: [0, 0, 0] normal: [0, 1, 0]"), 34, "point: [0, 0.0002, 0] normal: [0, 1, 0]");
+  what = setup_error_3d(shifted);
+  EXPECT_NE(what.find("mirror_planes[0] lies 0.2653 dp from the nearest row"), std::string::npos) << what;
+
+  std::string wide = kWedge;
+  wide.replace(wide.find("normal: [0.866025403784439, -0.5, 0]"), 36, "normal: [0.8, -0.6, 0]");
+  what = setup_error_3d(wide);
+  EXPECT_NE(what.find("field 'fluid.mirror_planes' (2 planes): mirror planes 0 and 1 bound a wedge of"), std::string::npos) << what;
+
+  std::string flat = kChannel;
+  flat.replace(flat.find("  walls {"), 0, "  fill_lattice: HEX_PRISM\n");
+  try {
+    fluid_setup_from_case<2>(parse_case_text(flat, "channel.textproto"), "channel.textproto");
+    FAIL() << "expected a CaseError";
+  } catch (const CaseError& e) {
+    what = e.what();
+    EXPECT_NE(what.find("channel.textproto: field 'fluid.fill_lattice' = HEX_PRISM with run.dimension = 2: allowed only CUBIC"),
+              std::string::npos) << what;
+  }
+}
+
 }  // namespace
 }  // namespace valvefsi::fluid

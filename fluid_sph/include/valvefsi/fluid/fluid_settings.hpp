@@ -52,9 +52,13 @@ struct FluidSettings {
   Vec<D> domain_upper{};
   std::array<bool, D> periodic{};
   // Symmetry planes at any angle (e.g. the two cut faces of a valve sector). The domain must
-  // reach a kernel support beyond each plane, where the mirror images live. Images of images
-  // (near the line where two planes meet) are not made.
+  // reach a kernel support beyond each plane, where the mirror images live. Where planes cross
+  // (a sector's axis) the images of images are made too: the whole finite group the
+  // reflections generate (mirror_group.hpp); planes that generate an infinite group are refused.
   std::vector<MirrorPlane<D>> mirror_planes;
+  // false: only each plane's own reflection (the fluid at a sector's axis then misses
+  // neighbours); kept to show what the images of images fix.
+  bool mirror_images_of_images = true;
 
   double smoothing_length() const { return smoothing_length_ratio * particle_spacing; }
   double support_radius() const { return 2.0 * smoothing_length(); }

@@ -14,6 +14,7 @@
 #include "valvefsi/fluid/cell_grid.hpp"
 #include "valvefsi/fluid/fluid_settings.hpp"
 #include "valvefsi/fluid/immersed_surface.hpp"
+#include "valvefsi/fluid/mirror_group.hpp"
 #include "valvefsi/fluid/pair_filter.hpp"
 #include "valvefsi/fluid/particles.hpp"
 #include "valvefsi/fluid/pressure_plate.hpp"
@@ -32,7 +33,8 @@ class TimeStepCollapse : public std::runtime_error {
 template <int D>
 class FluidSolver {
  public:
-  // Wall particles with body k > 0 belong to plates[k - 1]; body 0 walls are fixed.
+  // Wall particles with body k > 0 belong to plates[k - 1]; body 0 walls are fixed. Throws
+  // std::invalid_argument for mirror planes whose reflections generate an infinite group.
   FluidSolver(const FluidSettings<D>& settings, Particles<D> particles, std::vector<PressurePlate<D>> plates = {},
               std::unique_ptr<ImmersedSurfaceModel<D>> surface = nullptr);
 
@@ -122,6 +124,7 @@ class FluidSolver {
   bool body_forces_requested_ = false;
   bool body_forces_always_ = false;
   std::vector<std::uint32_t> mirror_keep_;  // scratch of refresh_mirror_images
+  std::vector<MirrorMap<D>> compound_mirror_maps_;  // images of images where planes cross
   double time_ = 0.0;
   double dt_ = 0.0;
   long steps_ = 0;

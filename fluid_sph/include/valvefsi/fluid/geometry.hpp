@@ -1,11 +1,12 @@
 #pragma once
 // Rigid walls from geometric primitives, and the lattice fill that turns a scene into
 // particles. Every primitive answers one question: how deep a point lies inside the solid
-// (> 0 inside). Fluid and dummy particles sit on one Cartesian lattice at
+// (> 0 inside). Fluid and dummy particles sit on one lattice, by default Cartesian at
 // origin + (i + 1/2) dp, so a wall face on a lattice plane gets its dummy layers at
-// dp/2, 3dp/2, ... behind it and the fluid at dp/2, 3dp/2, ... in front.
+// dp/2, 3dp/2, ... behind it and the fluid at dp/2, 3dp/2, ... in front (FillLattice).
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "valvefsi/fluid/fluid_settings.hpp"
@@ -50,13 +51,36 @@ struct FluidBlock {
   std::function<double(const Vec<D>&)> pressure;
 };
 
+// The lattice the fill puts particles on (one particle volume dp^D each).
+enum class FillLattice {
+  cubic,      // origin + (i + 1/2) dp along every axis
+  // 3D only: layers dp apart along `lattice_axis` (at origin + (k + 1/2) dp), each a triangular
+  // lattice of side a = dp (2/sqrt 3)^(1/2) with rows along `lattice_row_direction` and at 60
+  // and 120 degrees to it; the axis through the origin lies halfway between the rows of the
+  // first two families (0.465 dp from each). A sector whose cut faces run through the axis
+  // along those two families (a 60-degree wedge) then has its first row the same distance from
+  // both faces, where a cubic lattice leaves a slab of up to 0.8 dp empty along a face at 30
+  // degrees to it.
+  hex_prism,
+};
+
 template <int D>
 struct SceneGeometry {
   std::vector<std::shared_ptr<SolidShape<D>>> walls;   // fixed walls (body 0)
   std::vector<std::shared_ptr<SolidShape<D>>> plates;  // plate k is body k + 1
   std::vector<FluidBlock<D>> fluid;
   Vec<D> lattice_origin{};
+  FillLattice lattice = FillLattice::cubic;
+  Vec<D> lattice_axis{};           // hex_prism: unit direction of the layer stacking
+  Vec<D> lattice_row_direction{};  // hex_prism: unit direction of one row family, normal to the axis
 };
+
+// Where the hex-prism lattice fails a mirror plane: an empty string when every plane either
+// contains the axis, runs along a row family and lies halfway between two rows, or is normal to
+// the axis and lies halfway between two layers; otherwise which plane (its index) and why.
+// Also checks the axis and row directions. Empty for the cubic lattice.
+template <int D>
+std::string fill_lattice_mismatch(const SceneGeometry<D>& scene, const FluidSettings<D>& settings);
 
 // Fluid particles on lattice points inside a fluid block and outside every solid; dummy
 // particles on lattice points within `wall_layers` dp inside a wall or plate (default:

@@ -12,7 +12,8 @@ Scenes:
     coupling           explicit (SERIAL_EXPLICIT) | implicit (SERIAL_IMPLICIT, IQN-ILS)   (explicit)
     density_diffusion  delta-SPH coefficient (0 = off)                (0.1)
     background_pressure on | off (off: p_b = 0, the plates keep their offsets, so the fluid's
-                       pressure is the gauge pressure relative to the opening pressure)   (on)
+                       pressure is the gauge pressure relative to the opening pressure)
+                       (off, as valve2d.BACKGROUND_PRESSURE_2D: the committed cases)
     leaflet_density    solid density (kg/m^3); the window stays the default's, so mu grows
                        as the leaflet gets lighter                    (1100)
     thickness_mm       leaflet thickness (a strip mesh is written for it; window as above)  (0.25)
@@ -34,7 +35,7 @@ VALVE2D_DEFAULTS = {
     "time_step_factor": 1.0,
     "coupling": "explicit",
     "density_diffusion": 0.1,
-    "background_pressure": "on",
+    "background_pressure": "off",
     "leaflet_density": 1100.0,
     "thickness_mm": 0.25,
 }
@@ -84,7 +85,8 @@ def _valve2d_case(setting: dict, work: Path, end_time: float) -> Path:
     spec = valve2d.Case2D("FSI", material, "coarse")
     text = valve2d.case_text_2d(spec)
     cycles = max(1, math.ceil(end_time / valve2d.waveform.PERIOD_S - 1e-9))
-    text = case_edit.replace_block(text, "fluid", valve2d.fluid_block_2d(dp, cycles=cycles, sound_speed=c0))
+    text = case_edit.replace_block(text, "fluid", valve2d.fluid_block_2d(
+        dp, cycles=cycles, sound_speed=c0, background=s["background_pressure"] == "on"))
 
     thickness = float(s["thickness_mm"]) * 1e-3
     params = ValveParameters(thickness=thickness)
@@ -102,8 +104,6 @@ def _valve2d_case(setting: dict, work: Path, end_time: float) -> Path:
         "coupling.window_size": window,
         **COUPLING_SCHEMES[str(s["coupling"])],
     }
-    if s["background_pressure"] == "off":
-        overrides["fluid.background_pressure"] = 0.0
     for path, value in overrides.items():
         text = case_edit.set_field(text, path, value)
     for key, value in setting.items():

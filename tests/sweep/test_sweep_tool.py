@@ -10,6 +10,8 @@ import numpy as np
 
 from sweep import case_edit, metrics, outcome, plan, report, scenes
 
+ROOT = Path(__file__).resolve().parents[2]
+
 CASE = """# comment
 title: "x"
 run {
@@ -83,6 +85,18 @@ class Valve2dScene(unittest.TestCase):
             mesh = Path(tmp) / "w" / get("solid.mesh_file").strip('"')
             with h5py.File(mesh, "r") as f:
                 self.assertTrue(len(f.keys()) > 0)
+
+    def test_default_background_pressure_is_the_committed_cases_and_on_sets_the_opening_pressure(self):
+        from valve_scene import valve2d
+        committed = (ROOT / "cases" / "fsi-mhgo-2d-coarse.textproto").read_text()
+        with tempfile.TemporaryDirectory() as tmp:
+            default = scenes.write_case("valve2d", {}, Path(tmp) / "d", 0.01).read_text()
+            on = scenes.write_case("valve2d", {"background_pressure": "on"}, Path(tmp) / "on", 0.01).read_text()
+        p_b = lambda text: float(case_edit.get_field(text, "fluid.background_pressure"))
+        self.assertEqual(p_b(default), p_b(committed))
+        self.assertEqual(p_b(default) > 0, valve2d.BACKGROUND_PRESSURE_2D)
+        # 80.73 mmHg, the aortic pressure at opening
+        self.assertAlmostEqual(p_b(on), 80.73 * 133.322, delta=5.0)
 
     def test_unknown_axis_is_named(self):
         with tempfile.TemporaryDirectory() as tmp:

@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .valve_geometry import (LEAFLET_COUNT, SECTOR_HALF_ANGLE, ValveParameters, leaflet_point,
-                             leaflet_rotation)
+from .valve_geometry import (LEAFLET_COUNT, SECTOR_HALF_ANGLE, ValveParameters, commissure_fillet,
+                             leaflet_point, leaflet_rotation, tab_v_at_height)
 
 # Quad cells per leaflet (circumferential over the whole leaflet, radial). The medium full
 # valve has 3 * 48 * 28 * 2 = 8064 triangles (the reference used 7896 bricks).
@@ -42,26 +42,158 @@ class ValveMesh:
 
 
 def leaflet_grid(p: ValveParameters, cells_circumferential: int, cells_radial: int) -> np.ndarray:
-    """Nodes of leaflet 0, shape [nu + 1, nv + 1, 3]; rows uniform in arc length per column."""
+    """Nodes of leaflet 0, shape [nu + 1, nv + 1, 3]; rows uniform in arc length per column,
+    then, with a rounded commissure, the corner patches moved onto the trimmed surface."""
     nu, nv = cells_circumferential, cells_radial
     s = np.linspace(-1.0, 1.0, nu + 1)
     v_dense = np.linspace(0.0, 1.0, 801)
-    grid = np.empty((nu + 1, nv + 1, 3))
+    grid_v = np.empty((nu + 1, nv + 1))
     for i, s_i in enumerate(s):
         dense = leaflet_point(p, s_i, v_dense)
         arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(dense, axis=0), axis=1))])
-        v = np.interp(np.linspace(0.0, arc[-1], nv + 1), arc, v_dense)
-        grid[i] = leaflet_point(p, s_i, v)
-    return grid
+        grid_v[i] = np.interp(np.linspace(0.0, arc[-1], nv + 1), arc, v_dense)
+    grid_s = np.repeat(s[:, None], nv + 1, axis=1)
+    if p.commissure_fillet_radius > 0:
+        # the right half (s >= 0) rounded, the left half its exact mirror image
+        right = slice(nu // 2, nu + 1)
+        rounded_s, rounded_v = _rounded_corner_parameters(p, grid_s[right], grid_v[right], nv)
+        moved = ((rounded_s != grid_s[right]) | (rounded_v != grid_v[right]))[:0:-1]
+        grid_s[right], grid_v[right] = rounded_s, rounded_v
+        left_s, left_v = grid_s[:nu // 2], grid_v[:nu // 2]
+        left_s[moved], left_v[moved] = -rounded_s[:0:-1][moved], rounded_v[:0:-1][moved]
+    return leaflet_point(p, grid_s, grid_v)
 
 
-def quad_split(i: int, nu: int):
+def _smoothstep(x: np.ndarray, start: float) -> np.ndarray:
+    t = np.clip((x - start) / (1.0 - start), 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
+def _rounded_corner_parameters(p: ValveParameters, sigma: np.ndarray, grid_v: np.ndarray, nv: int):
+    """(s, v) of the grid nodes (|s| = sigma, rows nu = j / nv) with the commissure corner
+    rounded. The grid's corner node moves from C to G, the fillet's midpoint. The tab side's
+    last 2d (B..T1..C) becomes the path up the tab to T1 and along the arc to G, the free-edge
+    side's last 2d (..T2..C) the straight edge to T2 and the arc to G, each uniform in length;
+    the interior follows by a blend of the two boundary displacements (a Coons patch with
+    smoothstep weights) that vanishes outside the corner patch (the last 2d of rows and
+    columns), then Laplace smoothing; every node farther than 4.5d from C keeps its place."""
+    f = commissure_fillet(p)
+    d, half_arc = f.tangent_distance, 0.5 * f.arc_length
+    corner, midpoint = p.commissure_top(+1.0), p.free_edge_midpoint
+    edge_length = float(np.linalg.norm(midpoint - corner))
+    sigma_start = 1.0 - 2.0 * d / edge_length        # where the free-edge side starts to move
+    nu_start = 1.0 - 2.0 * d / p.tab_height           # where the tab side starts to move
+    path = d + half_arc                                # each side's new length (was 2d)
+    g_s, g_v = (float(x[0]) for x in f.arc_point([half_arc]))
+
+    def top_side(sig):                                 # free edge: (sigma, 1) -> new (s, v)
+        ell = np.clip((sig - sigma_start) / (1.0 - sigma_start), 0.0, 1.0) * path
+        arc_s, arc_v = f.arc_point(f.arc_length - (ell - d))
+        straight = ell <= d
+        return (np.where(straight, sigma_start + ell / edge_length, arc_s), np.where(straight, 1.0, arc_v))
+
+    def tab_side(nu):                                  # tab: row nu of column s = 1 -> new (s, v)
+        ell = np.clip((nu - nu_start) / (1.0 - nu_start), 0.0, 1.0) * path
+        arc_s, arc_v = f.arc_point(ell - d)
+        straight = ell <= d
+        on_tab = tab_v_at_height(p, corner[2] - 2.0 * d + np.minimum(ell, d))
+        return np.where(straight, 1.0, arc_s), np.where(straight, on_tab, arc_v)
+
+    nu = np.broadcast_to(np.arange(nv + 1) / nv, sigma.shape)
+    tab_v_original = tab_v_at_height(p, corner[2] - p.tab_height * (1.0 - nu))
+    top_s, top_v = top_side(sigma)
+    side_s, side_v = tab_side(nu)
+    w_sigma, w_nu = _smoothstep(sigma, sigma_start), _smoothstep(nu, nu_start)
+    moved = (sigma > sigma_start) & (nu > nu_start)
+    new_s = sigma + w_nu * (top_s - sigma) + w_sigma * (side_s - 1.0) - w_sigma * w_nu * (g_s - 1.0)
+    new_v = grid_v + w_nu * (top_v - 1.0) + w_sigma * (side_v - tab_v_original) - w_sigma * w_nu * (g_v - 1.0)
+    new_s, new_v = np.where(moved, new_s, sigma), np.where(moved, new_v, grid_v)
+    return _smooth_corner_patch(p, new_s, new_v, moved)
+
+
+def _smooth_corner_patch(p: ValveParameters, s: np.ndarray, v: np.ndarray, moved: np.ndarray, sweeps: int = 400):
+    """Laplace smoothing of the corner patch's interior nodes (each to the mean of its four grid
+    neighbours) in the tangent plane at the commissure, where the patch is nearly flat; the
+    blend alone leaves the rows squeezed against the arc. Boundary nodes (the trimmed edge, the
+    tab) and everything outside the patch stay; the smoothed points are mapped back onto the
+    surface by Newton on the same chart."""
+    corner = p.commissure_top(+1.0)
+    down = np.array([0.0, 0.0, -1.0])
+    along = p.free_edge_midpoint - corner
+    b = along - (along @ down) * down
+    basis = np.stack([down, b / np.linalg.norm(b)])
+
+    def chart(s_, v_):
+        return (leaflet_point(p, s_, v_) - corner) @ basis.T
+
+    interior = moved.copy()   # s >= 0 only: the last column is the tab, the last row the free edge
+    interior[-1, :] = False
+    interior[:, -1] = False
+    if not interior.any():
+        return s, v
+    x = chart(s, v)
+    for _ in range(sweeps):
+        mean = 0.25 * (np.roll(x, 1, 0) + np.roll(x, -1, 0) + np.roll(x, 1, 1) + np.roll(x, -1, 1))
+        x = np.where(interior[..., None], mean, x)
+    ss, vv = s[interior], v[interior]
+    target = x[interior]
+    h = 1e-7
+    for _ in range(30):
+        residual = chart(ss, vv) - target
+        if np.abs(residual).max() < 1e-13:
+            break
+        j_s = (chart(ss + h, vv) - chart(ss - h, vv)) / (2 * h)
+        j_v = (chart(ss, vv + h) - chart(ss, vv - h)) / (2 * h)
+        det = j_s[:, 0] * j_v[:, 1] - j_s[:, 1] * j_v[:, 0]
+        ss = ss - (residual[:, 0] * j_v[:, 1] - residual[:, 1] * j_v[:, 0]) / det
+        vv = vv - (j_s[:, 0] * residual[:, 1] - j_s[:, 1] * residual[:, 0]) / det
+    else:
+        raise RuntimeError("rounded commissure: the smoothed corner patch does not map back onto the leaflet surface")
+    s, v = s.copy(), v.copy()
+    s[interior], v[interior] = ss, vv
+    return s, v
+
+
+def quad_split(i: int, nu: int, flipped: bool = False):
     """Local corner pairs of the two triangles of quad column i, mirror-symmetric about the
-    bisector: the left half splits along (i,j)-(i+1,j+1), the right half along (i+1,j)-(i,j+1).
-    Corners are (di, dj) offsets, counter-clockwise in (s, v), i.e. seen from the outflow side."""
-    if i < nu // 2:
+    bisector: the left half splits along (i,j)-(i+1,j+1), the right half along (i+1,j)-(i,j+1);
+    `flipped` takes the other diagonal (a rounded commissure's corner patch, see
+    corner_patch_flips). Corners are (di, dj) offsets, counter-clockwise in (s, v), i.e. seen
+    from the outflow side."""
+    if (i < nu // 2) != flipped:
         return (((0, 0), (1, 0), (1, 1)), ((0, 0), (1, 1), (0, 1)))
     return (((0, 0), (1, 0), (0, 1)), ((1, 0), (1, 1), (0, 1)))
+
+
+def _smallest_angle(a, b, c) -> float:
+    angles = []
+    for p, q, r in ((a, b, c), (b, c, a), (c, a, b)):
+        u, w = q - p, r - p
+        angles.append(math.acos(max(-1.0, min(1.0, float(u @ w / (np.linalg.norm(u) * np.linalg.norm(w)))))))
+    return min(angles)
+
+
+def corner_patch_flips(p: ValveParameters, grid: np.ndarray) -> frozenset:
+    """Quads (i, j) of a rounded commissure's corner patches that split along their other
+    diagonal: the one whose two triangles have the larger smallest angle (the patch's cells
+    turn around the fillet, where the fixed diagonal direction leaves slivers). Chosen on the
+    right half, mirrored to the left; quads away from the commissure keep the fixed split."""
+    if p.commissure_fillet_radius <= 0:
+        return frozenset()
+    nu, nv = grid.shape[0] - 1, grid.shape[1] - 1
+    corner = p.commissure_top(+1.0)
+    reach = 3.0 * commissure_fillet(p).tangent_distance
+    flips = set()
+    for i in range(nu // 2, nu):
+        for j in range(nv):
+            a, b, c, d = grid[i, j], grid[i + 1, j], grid[i + 1, j + 1], grid[i, j + 1]
+            if min(np.linalg.norm(x - corner) for x in (a, b, c, d)) > reach:
+                continue
+            along_ac = min(_smallest_angle(a, b, c), _smallest_angle(a, c, d))
+            along_bd = min(_smallest_angle(a, b, d), _smallest_angle(b, c, d))
+            if along_ac > along_bd:          # the right half's default is b-d
+                flips.update({(i, j), (nu - 1 - i, j)})
+    return frozenset(flips)
 
 
 def _triangle_normals(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
@@ -70,14 +202,14 @@ def _triangle_normals(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
     return np.cross(b - a, c - a)
 
 
-def _local_triangles(nu: int, nv: int, columns: range):
+def _local_triangles(nu: int, nv: int, columns: range, flips: frozenset = frozenset()):
     """Triangles of leaflet-local grid indices (flattened over the kept columns)."""
     first = columns.start
     width = nv + 1
     tris, quad_of_tri = [], []
     for i in columns[:-1]:
         for j in range(nv):
-            for corners in quad_split(i, nu):
+            for corners in quad_split(i, nu, (i, j) in flips):
                 tris.append([(i + di - first) * width + (j + dj) for di, dj in corners])
                 quad_of_tri.append((i - first) * nv + j)
     return np.array(tris, dtype=np.int64), np.array(quad_of_tri, dtype=np.int64)
@@ -93,10 +225,10 @@ def _local_quads(nv: int, columns: range) -> np.ndarray:
     return np.array(quads, dtype=np.int64)
 
 
-def _node_normals(grid: np.ndarray, nu: int, nv: int) -> np.ndarray:
+def _node_normals(grid: np.ndarray, nu: int, nv: int, flips: frozenset = frozenset()) -> np.ndarray:
     """Unit normals at the grid nodes of the whole leaflet (area-weighted triangle normals)."""
     points = grid.reshape(-1, 3)
-    tris, _ = _local_triangles(nu, nv, range(0, nu + 1))
+    tris, _ = _local_triangles(nu, nv, range(0, nu + 1), flips)
     normals = _triangle_normals(points, tris)
     accumulated = np.zeros_like(points)
     for corner in range(3):
@@ -132,7 +264,8 @@ def build_valve_mesh(variant: str = "full", resolution: str = "medium", elements
         raise ValueError(f"cells {cells}: circumferential count must be even and >= 2, radial >= 1")
 
     grid0 = leaflet_grid(p, nu, nv)
-    normals0 = _node_normals(grid0, nu, nv)
+    flips = corner_patch_flips(p, grid0)
+    normals0 = _node_normals(grid0, nu, nv, flips)
     columns = range(0, nu + 1) if variant == "full" else range(nu // 2, nu + 1)
     leaflets = range(LEAFLET_COUNT) if variant == "full" else range(1)
     kept_grid = grid0[columns.start:].reshape(-1, 3)
@@ -142,8 +275,12 @@ def build_valve_mesh(variant: str = "full", resolution: str = "medium", elements
 
     local_i = np.repeat(np.arange(columns.start, nu + 1), width)
     local_j = np.tile(np.arange(width), len(columns))
-    is_attachment = (local_j == 0) | (local_i == 0) | (local_i == nu)
-    is_free_edge = local_j == nv
+    # the tab columns are sutured where they lie on the stent; a rounded commissure's arc above
+    # the tab (up to the grid corner) is free edge
+    on_stent = np.hypot(kept_grid[:, 0], kept_grid[:, 1]) >= p.annulus_radius * (1.0 - 1e-12)
+    tab_column = (local_i == 0) | (local_i == nu)
+    is_attachment = (local_j == 0) | (tab_column & on_stent)
+    is_free_edge = (local_j == nv) | (tab_column & ~on_stent)
     midpoint_local = int(np.flatnonzero((local_i == nu // 2) & is_free_edge)[0])
 
     mid = np.concatenate([kept_grid @ leaflet_rotation(k).T for k in leaflets])
@@ -163,7 +300,7 @@ def build_valve_mesh(variant: str = "full", resolution: str = "medium", elements
         blocks.append(mid + half * nrm)
     mesh = ValveMesh(nodes=np.concatenate(blocks))
 
-    tri_local, tri_quad = _local_triangles(nu, nv, columns)
+    tri_local, tri_quad = _local_triangles(nu, nv, columns, flips)
     quad_local = _local_quads(nv, columns)
     quad_count = len(quad_local)
     tris, tri_c, tri_r, hexes, hex_c, hex_r = [], [], [], [], [], []

@@ -23,6 +23,7 @@ import numpy as np
 
 from .analysis import (ROBUST_PEAK_FRACTION, ValveEvents, bisection_profile, geometric_orifice_area,
                        peak_with_location, robust_peak, triangle_areas, valve_events)
+from .valve_geometry import ValveParameters
 from .valve_mesh import build_valve_mesh
 from .report import REFERENCE_KINEMATICS_MS, REFERENCE_PEAKS, plot_kinematics, plot_profiles
 from .solid_results import SolidFields, read_series
@@ -48,6 +49,7 @@ class ModelResult:
     energy_error_max: float = float("nan")
     label: str = ""
     cpu_time_s: float | None = None
+    mesh_label: str = ""
 
     def __post_init__(self):
         self.label = self.label or self.spec.name
@@ -139,9 +141,10 @@ def analyse_windows(spec: CaseSpec, opening_dir: Path, closing_dir: Path, wall_t
     """RVOT, RVCT, ET and the peaks from the two windows: the free-edge curve of the opening window
     (cycle time 0-60 ms) joined to the closing window's after it settled (from 180 ms), the
     opening peaks from the first, the closed ones (300 ms) from the second."""
-    mesh = build_valve_mesh(spec.variant, spec.resolution, "triangles")
+    mesh = run_mesh(spec, opening_dir)
     R = float(mesh.description["param_annulus_radius"])
     result = ModelResult(spec, wall_time_s, None)
+    result.mesh_label = mesh_label(mesh)
     parts, errors = [], []
     for run_dir, offset, keep_from in ((opening_dir, OPENING_WINDOW[0], OPENING_WINDOW[0]),
                                        (closing_dir, CLOSING_WINDOW[0], CLOSING_WINDOW[0] + CLOSING_SETTLE_S)):
@@ -181,6 +184,23 @@ def analyse_windows(spec: CaseSpec, opening_dir: Path, closing_dir: Path, wall_t
     return result
 
 
+def run_mesh(spec: CaseSpec, run_dir: Path):
+    """The run's mesh rebuilt with its node sets: the generator's default (rounded commissure)
+    or, for runs made before it, the sharp one, whichever has the run's reference nodes."""
+    reference = SolidFields(run_dir).reference_nodes
+    for params in (ValveParameters(), ValveParameters(commissure_fillet_radius=0.0)):
+        mesh = build_valve_mesh(spec.variant, spec.resolution, "triangles", params)
+        if mesh.nodes.shape == reference.shape and np.allclose(mesh.nodes, reference, rtol=0, atol=1e-12):
+            return mesh
+    raise ValueError(f"{run_dir}: its mesh is neither the generator's {spec.variant} {spec.resolution} mesh "
+                     "with the default rounded commissure nor the sharp one")
+
+
+def mesh_label(mesh) -> str:
+    radius = float(mesh.description.get("param_commissure_fillet_radius", 0.0))
+    return f"commissure fillet {radius * 1e3:g} mm" if radius > 0 else "sharp commissure"
+
+
 def _window_peaks(result: ModelResult, name: str, fields: SolidFields, indices, t0: float, areas, mesh) -> None:
     """Element maximum (with its region) and robust peak of strain and stress over the snapshots
     `indices`, stored under `name`; a snapshot's cycle time is its run time + `t0`."""
@@ -203,7 +223,7 @@ def _window_peaks(result: ModelResult, name: str, fields: SolidFields, indices, 
 def analyse(spec: CaseSpec, run_dir: Path, cycle: int = 2, wall_time_s: float | None = None) -> ModelResult:
     """Kinematics, peaks and profiles of cycle `cycle` (1-based) of a finished run."""
     t0 = (cycle - 1) * PERIOD_S
-    mesh = build_valve_mesh(spec.variant, spec.resolution, "triangles")   # the case's mesh, rebuilt
+    mesh = run_mesh(spec, run_dir)   # the case's mesh, rebuilt
     R = float(mesh.description["param_annulus_radius"])
     sector = spec.variant == "sector"
     series = read_series(run_dir)
@@ -211,7 +231,7 @@ def analyse(spec: CaseSpec, run_dir: Path, cycle: int = 2, wall_time_s: float | 
     t = series.time[in_cycle] - t0
     x = series.midpoint_positions[in_cycle]
     radial = np.hypot(x[..., 0], x[..., 1]).mean(axis=1)
-    result = ModelResult(spec, wall_time_s, None)
+    result = ModelResult(spec, wall_time_s, None, mesh_label=mesh_label(mesh))
     result.energy_error_max = float(np.nanmax(np.abs(series.energy_balance_error))) if len(series.time) else float("nan")
     try:
         result.events = valve_events(t, radial)
@@ -369,11 +389,11 @@ def main(argv=None) -> None:
                 wall, cpu = recorded_times(dirs)
                 results.append(analyse_windows(spec, *dirs, wall_time_s=wall))
                 results[-1].cpu_time_s = cpu
-                results[-1].label = f"{spec.name} (windows)"
+                results[-1].label = f"{spec.name} (windows, {results[-1].mesh_label})"
                 opening_dirs.append(dirs[0])
                 if args.cycle_runs_dir and (args.cycle_runs_dir / spec.name).exists():
                     results.append(analyse(spec, args.cycle_runs_dir / spec.name, cycle=args.cycle))
-                    results[-1].label = f"{spec.name} (cycle {args.cycle})"
+                    results[-1].label = f"{spec.name} (cycle {args.cycle}, {results[-1].mesh_label})"
             else:
                 wall = None if args.skip_run else run_case(spec, args.build_dir, args.runs_dir / "logs", args.runs_dir)
                 results.append(analyse(spec, args.runs_dir / spec.name, cycle=args.cycle, wall_time_s=wall))

@@ -19,6 +19,8 @@
 #include "valvefsi/coupling/participant.hpp"
 #include "valvefsi/coupling/restart_file.hpp"
 #include "valvefsi/solid/case_setup.hpp"
+#include "valvefsi/solid/energy_growth_error.hpp"
+#include "valvefsi/solid/energy_growth_report.hpp"
 #include "valvefsi/solid/material_error.hpp"
 #include "valvefsi/solid/solid_interface.hpp"
 #include "valvefsi/solid/solid_output.hpp"
@@ -28,7 +30,7 @@ namespace valvefsi::solid {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr int kExitSolidFailure = 6;  // the solid's own failure (material state), after an Abort
+constexpr int kExitSolidFailure = 6;  // the solid's own failure (material state, energy growth), after an Abort
 
 // Output at accepted window ends: with an implicit scheme a window is accepted only when the
 // next one does not restore it, so the state is written when the following window opens.
@@ -151,7 +153,18 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
         write_solver_restart(solver, coupling::restart_file_path(window.restart_directory, participant->name()));
       }
       interface.nodal_forces(window.loads.forces, setup.mesh.num_nodes(), nodal_forces);
-      solver.advance_window(window.end(), &nodal_forces);
+      try {
+        solver.advance_window(window.end(), &nodal_forces);
+      } catch (const EnergyGrowthError& e) {
+        // Write the state of the failing step as the last output, then stop as for a material failure.
+        output.accepted(solver, true);
+        throw EnergyGrowthError(fmt::format("{} Kinetic energy's element: {}. The last sample and snapshot of {} hold "
+                                            "this state.", e.what(),
+                                            kinetic_energy_element(setup.mesh, setup.element_family, solver,
+                                                                   e.hottest_node()),
+                                            output_dir.string()),
+                                e.hottest_node());
+      }
       have_unwritten_state = true;
       interface.motion(solver.state(), motion.positions, motion.velocities);
       participant->complete_window(motion, 0.0);  // the explicit solid sub-cycles: any window is stable
@@ -181,6 +194,10 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
     spdlog::error("{}", e.what());
     if (participant) participant->abort(e.what());
     return e.exit_code();
+  } catch (const EnergyGrowthError& e) {
+    spdlog::error("{}", e.what());
+    if (participant) participant->abort(std::string("solid_fe: ") + e.what());
+    return kExitSolidFailure;
   } catch (const MaterialStateError& e) {
     spdlog::error("{}", e.what());
     if (participant) participant->abort(std::string("solid_fe: ") + e.what());

@@ -20,6 +20,8 @@
 #include "valvefsi/coupling/restart_file.hpp"
 #include "valvefsi/coupling/restart_points.hpp"
 #include "valvefsi/solid/case_setup.hpp"
+#include "valvefsi/solid/energy_growth_error.hpp"
+#include "valvefsi/solid/energy_growth_report.hpp"
 #include "valvefsi/solid/material_error.hpp"
 #include "valvefsi/solid/solid_output.hpp"
 #include "valvefsi/solid/solver_restart.hpp"
@@ -120,6 +122,15 @@ int run_fe_only(const valvefsi::cases::Case& c, const std::filesystem::path& cas
     spdlog::error("{}", e.what());
     spdlog::error("stopping at t = {} s; the output holds the state up to the last completed window",
                   solver.state().time);
+    status = 3;
+  } catch (const EnergyGrowthError& e) {
+    // The state is that of a completed step: write it as the last sample and snapshot.
+    spdlog::error("{} Kinetic energy's element: {}.", e.what(),
+                  kinetic_energy_element(setup.mesh, setup.element_family, solver, e.hottest_node()));
+    sample();
+    if (snapshot_interval > 0) snapshot();
+    spdlog::error("stopping at t = {} s; the last sample and snapshot of {} hold this state", solver.state().time,
+                  output_dir.string());
     status = 3;
   }
   series.flush();

@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 
+#include "valvefsi/solid/energy_growth_error.hpp"
 #include "valvefsi/solid/material_error.hpp"
 
 namespace valvefsi::solid {
@@ -18,6 +19,16 @@ double EnergyBalance::relative_balance_error() const {
                                  std::abs(initial_kinetic),
                                  1e-300});
   return std::abs(balance()) / scale;
+}
+
+void EnergyBalance::update_largest_energy() {
+  largest_energy = std::max({largest_energy, std::abs(kinetic), std::abs(internal_work), std::abs(strain_energy),
+                             std::abs(external_work), std::abs(damping_work), std::abs(contact_work),
+                             std::abs(tie_work), std::abs(initial_kinetic)});
+}
+
+double EnergyBalance::balance_error_of_largest() const {
+  return std::abs(balance()) / std::max(largest_energy, 1e-300);
 }
 
 ExplicitSolver::ExplicitSolver(std::unique_ptr<ElementModel> elements, SolverOptions options)
@@ -526,7 +537,50 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
     compute_acceleration(inverse_mass);
     state_.velocity = v_half + 0.5 * dt * a;
     update_kinetic_energy();
+    state_.energy.update_largest_energy();
+    if (options_.max_energy_balance_error > 0.0 && state_.step >= kEnergyCheckFirstStep) check_energy_growth();
   }
+}
+
+void ExplicitSolver::check_energy_growth() const {
+  const EnergyBalance& e = state_.energy;
+  // Energies below the kinetic energy of the whole model moving at 1e-3 of its size per second
+  // are round-off (a strip at rest: 1e-32 J, "20 %" errors); they are not checked.
+  const Eigen::Matrix3Xd& reference = elements_->reference_positions();
+  const double size = (reference.rowwise().maxCoeff() - reference.rowwise().minCoeff()).norm();
+  const double floor = 0.5 * elements_->nodal_mass().sum() * (1e-3 * size) * (1e-3 * size);
+  if (e.largest_energy < floor) return;
+  const double error = e.balance_error_of_largest();
+  if (error <= options_.max_energy_balance_error) return;  // (a NaN balance stops too)
+  // Where the kinetic energy sits: the node with the most, and its share of the total.
+  const Eigen::VectorXd& mass = elements_->nodal_mass();
+  Eigen::Index hottest = 0;
+  double hottest_energy = -1.0;
+  for (Eigen::Index i = 0; i < state_.velocity.cols(); ++i) {
+    const double k = 0.5 * mass(i) * state_.velocity.col(i).squaredNorm();
+    if (k > hottest_energy) {
+      hottest_energy = k;
+      hottest = i;
+    }
+  }
+  const Eigen::Vector3d x = state_.position.col(hottest);
+  throw EnergyGrowthError(
+      fmt::format(
+          "solid: energy growth at t = {:.6g} s, step {}: the energy balance error is {:.3g} of the largest energy "
+          "seen ({:.4g} J), above solid.max_energy_balance_error = {:.3g}. Energies (J): kinetic {:.4g}, strain {:.4g}, "
+          "internal work {:.4g}, external work {:.4g}, contact work {:.4g}, damping work {:.4g}, tie work {:.4g}, "
+          "balance {:.4g}. Kinetic energy concentrates at node {} (at [{:.4g}, {:.4g}, {:.4g}] m, {:.3g} J = {:.1f} % "
+          "of it); dt = {:.3g} s (element {}, calibration x{:.2f}), {} nodes in contact. The time integration is "
+          "creating energy: lower solid.time_step_safety (now {:.3g}) or solid.max_time_step_growth (now {:.3g}), "
+          "lower solid.contact_stiffness_factor (now {:.3g}) if the node is in contact, or damp the flutter with "
+          "solid.mass_damping_per_s (now {:.3g}); 0 turns this check off.",
+          state_.time, state_.step, error, e.largest_energy, options_.max_energy_balance_error, e.kinetic,
+          e.strain_energy, e.internal_work, e.external_work, e.contact_work, e.damping_work, e.tie_work, e.balance(),
+          hottest, x.x(), x.y(), x.z(), hottest_energy, 100.0 * hottest_energy / std::max(e.kinetic, 1e-300),
+          state_.stable_step, state_.critical_element, state_.step_calibration, state_.nodes_in_contact,
+          step_factor_ > 0.0 ? step_factor_ : options_.time_step_safety, options_.max_time_step_growth,
+          options_.contact_stiffness_factor, options_.mass_damping_per_s),
+      hottest);
 }
 
 void ExplicitSolver::add_work(const Eigen::Matrix3Xd& dx) {

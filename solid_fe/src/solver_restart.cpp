@@ -72,6 +72,7 @@ void write_solver_restart(const ExplicitSolver& solver, coupling::RestartWriter&
   for (int k = 0; k < static_cast<int>(std::size(kEnergyNames)); ++k) {
     file.put(fmt::format("solid/energy/{}", kEnergyNames[k]), *energy_field(energy, k));
   }
+  file.put("solid/energy/largest_energy", s.energy.largest_energy);
   file.put("solid/step_calibration", s.step_calibration);
   file.put("solid/highest_frequency", s.highest_frequency);
   file.put("solid/calibrated_step", s.calibrated_step);
@@ -140,6 +141,8 @@ void read_solver_restart(const coupling::RestartReader& file, ExplicitSolver& so
   for (int k = 0; k < static_cast<int>(std::size(kEnergyNames)); ++k) {
     *energy_field(s.energy, k) = file.scalar(fmt::format("solid/energy/{}", kEnergyNames[k]));
   }
+  // (files of session 4 have no largest_energy: the energy-growth scale then starts anew)
+  s.energy.largest_energy = file.has("solid/energy/largest_energy") ? file.scalar("solid/energy/largest_energy") : 0.0;
   s.step_calibration = file.scalar("solid/step_calibration");
   s.highest_frequency = file.scalar("solid/highest_frequency");
   s.calibrated_step = file.scalar("solid/calibrated_step");

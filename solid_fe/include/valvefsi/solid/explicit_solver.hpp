@@ -37,12 +37,18 @@ struct EnergyBalance {
   // coupling's interface energy error (docs/solid_fe.md, "Energy in coupled runs").
   double interface_work = 0;
   double initial_kinetic = 0;
+  // Largest energy term seen so far in the run (J): the scale of the energy-growth stop.
+  double largest_energy = 0;
   // KE + W_int + W_damp + W_contact + W_tie - W_ext - KE0: zero for exact time integration.
   double balance() const {
     return kinetic + internal_work + damping_work + contact_work + tie_work - external_work - initial_kinetic;
   }
-  // |balance| relative to the largest energy term.
+  // |balance| relative to the largest energy term now.
   double relative_balance_error() const;
+  // |balance| relative to the largest energy term seen in the run (largest_energy).
+  double balance_error_of_largest() const;
+  // Raises largest_energy to the largest energy term now.
+  void update_largest_energy();
 };
 
 struct SolverState {
@@ -112,7 +118,14 @@ struct SolverOptions {
   double max_step_calibration = 1.5;     // the calibrated step is at most this times the element estimate
   double max_time_step_growth = 0;       // > 0: dt grows by at most this fraction per step
   double fixed_time_step = 0;           // > 0: this step, no estimate (tests of the stability limit)
+  // > 0: stop (EnergyGrowthError) when |balance| exceeds this fraction of the largest energy
+  // seen, checked every step from step kEnergyCheckFirstStep on; 0 = off.
+  double max_energy_balance_error = 0;
 };
+
+// The energy-growth check starts here: the first steps' balance is a ratio of round-off-sized
+// energies.
+inline constexpr std::int64_t kEnergyCheckFirstStep = 100;
 
 class ExplicitSolver {
  public:
@@ -183,6 +196,8 @@ class ExplicitSolver {
   void compute_acceleration(const Eigen::ArrayXd& inverse_mass);
   void apply_constraints(Eigen::Matrix3Xd& field) const;
   void update_kinetic_energy();
+  // Throws EnergyGrowthError when the balance error passes options_.max_energy_balance_error.
+  void check_energy_growth() const;
   void add_work(const Eigen::Matrix3Xd& dx);
   bool has_contact() const { return !contact_planes_.empty() || !contact_cylinders_.empty() || leaflet_contact_; }
 

@@ -7,8 +7,10 @@ Scenes:
     material           MHGO | Ogden                                   (MHGO)
     spacing_mm         fluid particle spacing                         (1.0)
     sound_speed        fluid c0 (m/s)                                 (20)
-    time_step_factor   f: fluid.cfl = 0.2 f and the coupling window = f x the window at which
-                       mu = 2 rho_f c0 dt / (rho_s t) = 1 for the default leaflet (so f = mu) (1)
+    time_step_factor   f: fluid.cfl = f x the committed CFL (valve2d.FLUID_CFL_2D, 0.1) and the
+                       coupling window = f x the committed window (valve2d.coupling_window:
+                       COUPLING_WINDOW_FACTOR_2D = 2 x the window at which
+                       mu = 2 rho_f c0 dt / (rho_s t) = 1 for the default leaflet)   (1)
     coupling           explicit (SERIAL_EXPLICIT) | implicit (SERIAL_IMPLICIT, IQN-ILS)   (explicit)
     density_diffusion  delta-SPH coefficient (0 = off)                (0.1)
     background_pressure on | off (off: p_b = 0, the plates keep their offsets, so the fluid's
@@ -39,7 +41,6 @@ VALVE2D_DEFAULTS = {
     "leaflet_density": 1100.0,
     "thickness_mm": 0.25,
 }
-DEFAULT_CFL = 0.2
 COUPLING_SCHEMES = {
     "explicit": {"coupling.scheme": "SERIAL_EXPLICIT"},
     "implicit": {"coupling.scheme": "SERIAL_IMPLICIT", "coupling.acceleration": "IQN_ILS",
@@ -93,13 +94,13 @@ def _valve2d_case(setting: dict, work: Path, end_time: float) -> Path:
     mesh_path = work / "meshes" / f"valve-2d-coarse-t{thickness * 1e6:.0f}um.mesh.h5"
     if not mesh_path.exists():
         write_mesh(valve2d.build_strip_mesh("coarse", params=params), mesh_path)
-    window = factor * valve2d.coupling_window(c0)   # the default leaflet's mu = 1 window
+    window = factor * valve2d.coupling_window(c0)   # the committed window at this c0
     overrides = {
         "run.end_time": float(end_time),
         "run.output_dir": "run",
         "solid.mesh_file": str(mesh_path.relative_to(work)),
         "solid.density": float(s["leaflet_density"]),
-        "fluid.cfl": DEFAULT_CFL * factor,
+        "fluid.cfl": valve2d.FLUID_CFL_2D * factor,
         "fluid.density_diffusion": float(s["density_diffusion"]),
         "coupling.window_size": window,
         **COUPLING_SCHEMES[str(s["coupling"])],

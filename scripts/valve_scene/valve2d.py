@@ -58,6 +58,14 @@ LEAFLET_SHAPES = ("flat", "belly")
 # (fsi.valve2d_first_10ms bounds it at 20 N/m) and the xcoarse taps spike by ~100 mmHg in the
 # opening; session 4 ran the xcoarse cycles both ways (docs/fsi-2d.md). Off until one is fixed.
 BACKGROUND_PRESSURE_2D = False
+# The fluid's CFL number and the coupling window (a multiple of the mu = 1 window), from the
+# stability map (docs/stability-map.md, session 5): with the leaflets two-sided along their whole
+# length (the sinus behind them), the coarse valve at CFL 0.2 and the mu = 1 window (6.5 us) runs
+# away at 25 ms (a free edge at 22 m/s, 1,300 N/m); CFL 0.15 at 28.8 ms; CFL 0.1 reaches 30 ms
+# but with 796 N/m. With CFL 0.1 and a window of 2 or 3 x (13 or 19.5 us, the fluid sub-cycling
+# twice or three times) the leaflet force stays at 3 N/m and the edge below 0.6 m/s.
+FLUID_CFL_2D = 0.1
+COUPLING_WINDOW_FACTOR_2D = 2.0
 # The coaptation tie (solid_fe, docs/solid_fe.md "Coaptation tie"): the touching tips are held
 # on the annulus plane until the tie pulls harder than this per metre of depth. A forward
 # gradient dp loads the 11.25 mm flap with dp L = 1.5 N/m per mmHg, and a flap held at both ends
@@ -257,13 +265,18 @@ def sound_speed_2d() -> float:
     return 10.0 * math.ceil(2.0 * peak_forward_velocity()) / 2.0
 
 
-def coupling_window(sound_speed: float, valve: ValveParameters | None = None) -> float:
+def mu_one_window(sound_speed: float, valve: ValveParameters | None = None) -> float:
     """Largest window with mu = 2 rho_f c dt / (rho_s t) <= 1 (docs/coupling-numerics.md (b):
-    serial explicit is stable for mu < 2; the leaflet has fluid on both sides, hence the 2),
+    serial explicit is stable for mu < 2 in 1D; the leaflet has fluid on both sides, hence the 2),
     rounded down to 0.5 us."""
     valve = valve or ValveParameters()
     window = LEAFLET_DENSITY * valve.thickness / (2.0 * BLOOD_DENSITY * sound_speed)
     return math.floor(window / 0.5e-6) * 0.5e-6
+
+
+def coupling_window(sound_speed: float, valve: ValveParameters | None = None) -> float:
+    """The cases' window: COUPLING_WINDOW_FACTOR_2D x the mu = 1 window."""
+    return COUPLING_WINDOW_FACTOR_2D * mu_one_window(sound_speed, valve)
 
 
 
@@ -301,6 +314,8 @@ def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Chann
         f"  # 10x the Bernoulli speed of the peak forward gradient ({peak_forward_velocity():.2f} m/s, rounded up)",
         f"  sound_speed: {c0:g}",
         "  density_diffusion: 0.1",
+        f"  # the fluid's step: CFL {FLUID_CFL_2D:g} (at 0.2 the coarse 2D valve runs away, docs/stability-map.md)",
+        f"  cfl: {FLUID_CFL_2D:g}",
         "  # shifting keeps the leaflets' free ends stable (docs/thin-leaflet.md)",
         "  shifting: 1",
         *([f"  # the fluid starts at the aortic pressure at opening ({offset:g} mmHg): background pressure",
@@ -456,8 +471,9 @@ def case_text_2d(spec: Case2D) -> str:
         parts += [fluid_block_2d(PARTICLE_SPACING_2D[spec.resolution], background=BACKGROUND_PRESSURE_2D),
                   "coupling {\n"
                   "  scheme: SERIAL_EXPLICIT\n"
-                  f"  # acoustic estimate mu = 2 rho c dt / (rho_s t) = {2 * BLOOD_DENSITY * c0 * coupling_window(c0) / (LEAFLET_DENSITY * ValveParameters().thickness):.2f} (stable below 2);\n"
-                  "  # the first coupled trial was unstable all the same (docs/valve-scene.md, 2D valve scene)\n"
+                  f"  # acoustic estimate mu = 2 rho c dt / (rho_s t) = {2 * BLOOD_DENSITY * c0 * coupling_window(c0) / (LEAFLET_DENSITY * ValveParameters().thickness):.2f} (the 1D piston's limit is 2);\n"
+                  f"  # {COUPLING_WINDOW_FACTOR_2D:g} x the mu = 1 window, the fluid sub-cycling at CFL {FLUID_CFL_2D:g}: stable where\n"
+                  "  # the mu = 1 window is not (docs/stability-map.md)\n"
                   f"  window_size: {coupling_window(c0):g}\n"
                   "  mapping: NEAREST_PROJECTION\n"
                   "}\n"]

@@ -169,9 +169,10 @@ class Geometry(unittest.TestCase):
     def test_sound_speed_and_coupling_window(self):
         self.assertAlmostEqual(valve2d.peak_forward_velocity(), 1.57, delta=0.02)
         self.assertEqual(valve2d.sound_speed_2d(), 20.0)
-        w = valve2d.coupling_window(20.0)
+        w = valve2d.mu_one_window(20.0)
         mu = 2 * valve2d.BLOOD_DENSITY * 20.0 * w / (valve2d.LEAFLET_DENSITY * P.thickness)
         self.assertTrue(0.9 < mu <= 1.0)
+        self.assertEqual(valve2d.coupling_window(20.0), valve2d.COUPLING_WINDOW_FACTOR_2D * w)
 
 
 class CaseFiles2D(unittest.TestCase):

@@ -47,7 +47,7 @@ class ValveParameters:
     belly: float = 0.5                     # beta in [0, 1): depth of the leaflet belly
     coaptation_gap: float = 0.5e-3         # gap between neighbouring free edges (nearly closed)
     thickness: float = 0.25e-3             # leaflet thickness
-    commissure_fillet_radius: float = 2.0e-3  # rho: rounds the free edge into the tab (0 = sharp corner; docs: valve-scene.md)
+    commissure_fillet_radius: float = 0.0     # rho: rounds the free edge into the tab (0 = sharp corner; 2 mm measured, not yet robust: docs/valve-scene.md)
 
     def validate(self) -> None:
         checks = [

@@ -63,8 +63,8 @@ class OrificeArea(unittest.TestCase):
         self.assertAlmostEqual(goa / (0.5 * math.pi * R * R), 1.0, delta=2e-3)
 
     def test_closed_generated_valve_matches_its_exact_slit_area(self):
-        # the exact slits are those of straight free edges: the sharp commissure (the default
-        # 2 mm fillet's trimmed corners add 0.2 mm^2, +1.2 %, in top view)
+        # the exact slits are those of straight free edges: the sharp commissure (a 2 mm
+        # fillet's trimmed corners add 0.2 mm^2, +1.2 %, in top view)
         mesh = build_valve_mesh("full", "medium", "triangles", ValveParameters(commissure_fillet_radius=0.0))
         exact = closed_valve_goa(P, 48)
         goa = geometric_orifice_area(mesh.nodes, mesh.triangles, R, pixels_across=2000)

@@ -86,7 +86,11 @@ std::optional<Crossing> segment_meets(const Vec2& a, const Vec2& b, const Vec2& 
   const Vec2 ap = sub(a, p);
   const double s = cross(ap, e) / denominator;
   const double t = cross(ap, r) / denominator;
-  if (s < 0.0 || s > 1.0 || t < 0.0 || t > 1.0) return std::nullopt;
+  // Touching counts, with a margin far above round-off along the wall: a segment through an
+  // interior node must meet one of its two segments whatever the rounding (without it such a
+  // ray slipped through the node now and then, and the wall's rates jumped when it moved by an ulp).
+  constexpr double margin = 1e-12;
+  if (s < 0.0 || s > 1.0 || t < -margin || t > 1.0 + margin) return std::nullopt;
   return Crossing{0, t, s};
 }
 

@@ -14,6 +14,8 @@
 #include "solid_coupled_run.hpp"
 #include "test_meshes.hpp"
 #include "valvefsi/case/pressure_waveform.hpp"
+#include "valvefsi/solid/saint_venant_kirchhoff.hpp"
+#include "valvefsi/solid/shell_solver.hpp"
 
 namespace valvefsi::solid::testing {
 namespace {
@@ -92,6 +94,32 @@ TEST(SolidParticipant, KilledFluidStopsTheSolidWithAMessage) {
   ASSERT_TRUE(code.has_value()) << "solid still running:\n" << run.logs();
   EXPECT_NE(*code, 0);
   EXPECT_NE(run.solid->log_text().find("participant 'fluid'"), std::string::npos) << run.logs();
+}
+
+// The energy-growth stop in coupled mode: the cantilever with a forced step just above its
+// critical step 2/omega_max (SVK 1 MPa as the case's default, Lanczos) gains energy; solid_fe
+// stops with exit code 6 (the solid's own failure), names the energy growth and the element,
+// and the coupler is told (docs/solid_fe.md, "Energy-growth stop").
+TEST(SolidParticipant, EnergyGrowthStopsTheCoupledSolid) {
+  auto spec = cantilever("solid-energy-growth");
+  SolverOptions options;
+  options.time_step_calibration_interval = 1000000;
+  options.max_step_calibration = 10.0;
+  ShellModelOptions model_options;
+  model_options.fixed_nodes = spec.mesh.node_sets.at("attachment");
+  ShellSolver probe(build_shell_model(spec.mesh, model_options), SaintVenantKirchhoff(1e6, 0.3), options);
+  probe.advance_window(0.0);
+  const double critical = probe.state().calibrated_step;
+  ASSERT_GT(critical, 0.0);
+  spec.solid_extra += fmt::format(" forced_time_step: {:.15g}", 1.002 * critical);
+  spec.end_time = 3000 * critical;
+  SolidCoupledRun run(spec);
+  EXPECT_EQ(run.wait(60), 6) << run.logs();
+  const std::string log = run.solid->log_text();
+  for (const char* part : {"energy growth at t =", "Kinetic energy's element: element", "hold this state"}) {
+    EXPECT_NE(log.find(part), std::string::npos) << part << " missing in:\n" << run.logs();
+  }
+  EXPECT_TRUE(std::filesystem::exists(run.output / "solid_series.h5"));
 }
 
 // 2D: a plane-strain strip cantilever (20 segments) under the strip fluid's pressure (forces per

@@ -70,6 +70,38 @@ TEST(ThinWallModel3D, MirrorImagesShareTheNodesOnThePlane) {
   EXPECT_TRUE(closest_point(model.mesh(), {0.6, 1.2, 0.5}).on_boundary);
 }
 
+// A 60-degree sector (planes y = 0 and the one at 60 degrees to it, meeting on the z axis): the
+// fluid makes the images of images near the axis, so the leaflet is copied under the whole group
+// of six (identity, two reflections, two rotations by 120 degrees, the third reflection). A node
+// on a plane is shared by the copies that meet there; every copy keeps the real sides.
+TEST(ThinWallModel3D, ASectorsLeafletIsCopiedUnderTheWholeGroupOfItsPlanes) {
+  auto s = settings(0.1);
+  s.mirror_planes.push_back({{0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}});
+  s.mirror_planes.push_back({{0.0, 0.0, 0.0}, {0.5 * std::sqrt(3.0), -0.5, 0.0}});
+  // x = 0.5, y in [0, 0.2] (from the plane y = 0, at most 21.8 degrees), z in [0, 1]: 25 nodes,
+  // 5 on the plane y = 0, 32 triangles.
+  const ThinWallModel3D model(rectangle_mesh({0.5, 0.0, 0.0}, {0.0, 0.2, 0.0}, {0.0, 0.0, 1.0}, 4, 4), s, {});
+  // 20 nodes off the planes in 6 copies, the 5 on y = 0 in 3 (each shared by two copies).
+  EXPECT_EQ(model.mesh().position.size(), 20u * 6u + 5u * 3u);
+  EXPECT_EQ(model.mesh().triangles.size(), 32u * 6u);
+  EXPECT_EQ(model.real_triangle_count(), 32u);
+  // A point and its images under the rotations by 120 and 240 degrees: the same distance and
+  // side; the line y = 0 of the rotated copies is no free edge either.
+  const Vec3 x{0.6, 0.1, 0.5};
+  const auto c = closest_point(model.mesh(), x);
+  EXPECT_EQ(c.side, 1);
+  EXPECT_NEAR(c.distance, 0.1, 1e-12);
+  for (const double degrees : {120.0, 240.0}) {
+    const double a = degrees * std::acos(-1.0) / 180.0;
+    const Vec3 y{std::cos(a) * x[0] - std::sin(a) * x[1], std::sin(a) * x[0] + std::cos(a) * x[1], x[2]};
+    const auto r = closest_point(model.mesh(), y);
+    EXPECT_EQ(r.side, c.side) << degrees << " degrees";
+    EXPECT_NEAR(r.distance, c.distance, 1e-12) << degrees << " degrees";
+    const Vec3 on_line{std::cos(a) * 0.6, std::sin(a) * 0.6, 0.5};  // the rotated line y = 0, 0.1 off the copy
+    EXPECT_FALSE(closest_point(model.mesh(), on_line).on_boundary) << degrees << " degrees";
+  }
+}
+
 TEST(ThinWallModel3D, APairWithAMirrorImageIsBlockedByTheImageLeaflet) {
   for (const bool mirror : {false, true}) {
     auto s = settings(0.05);  // support 0.13 m

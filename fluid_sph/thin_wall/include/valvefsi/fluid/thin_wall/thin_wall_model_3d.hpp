@@ -13,10 +13,12 @@
 //                       with the barycentric weights of the wall point seen; gauge loads
 //   correct_crossings - swept test against the moving triangles, put back on the start side
 //   accept_shift      - shifting never crosses or comes within the clearance
-// Fluid mirror planes (sector cases): the mesh is extended by its mirror image in every plane,
-// so pairs between a particle and a mirror image, the lattice behind the leaflet near a plane
-// and the side of image particles all see the image leaflet; a load seen on an image triangle
-// is reflected back onto the real nodes (the mirror fluid's share of the real leaflet's load).
+// Fluid mirror planes (sector cases): the mesh is extended by its mirror image in every plane
+// and, where the planes cross, under every other element of the group they generate (the
+// fluid's images of images, mirror_group.hpp), so pairs between a particle and an image, the
+// lattice behind the leaflet near a plane and the side of image particles all see the image
+// leaflet; a load seen on an image triangle is mapped back onto the real nodes (the image
+// fluid's share of the real leaflet's load).
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -27,6 +29,7 @@
 #include "thin_wall_case.pb.h"
 #include "valvefsi/fluid/fluid_settings.hpp"
 #include "valvefsi/fluid/immersed_surface.hpp"
+#include "valvefsi/fluid/mirror_group.hpp"
 #include "valvefsi/fluid/thin_wall/triangle_mesh.hpp"
 #include "valvefsi/fluid/thin_wall/window_motion.hpp"
 
@@ -131,9 +134,11 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
   };
 
   void place_mesh();  // mesh_ (with images) from dyn_.x, v, a
-  // Real node and mirror plane (-1: none) of mesh node k.
+  // Real node of mesh node k.
   std::uint32_t real_node(std::uint32_t k) const { return origin_node_[k]; }
-  Vec3 reflect_vector(int plane, const Vec3& v) const;
+  // A real vector seen at the image under map m (-1: none), and back.
+  Vec3 to_image(int map, const Vec3& v) const;
+  Vec3 to_real(int map, const Vec3& v) const;
 
   FluidSettings<3> fluid_;
   ThinWall3DSettings settings_;
@@ -141,8 +146,10 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
   std::size_t real_triangles_ = 0;
   std::vector<MirrorPlane<3>> planes_;
   std::vector<std::uint32_t> origin_node_;  // per mesh node: its real node
-  std::vector<int> node_plane_;             // per mesh node: the plane it is the image in (-1)
-  std::vector<int> triangle_plane_;         // per mesh triangle: the plane (-1: real)
+  std::vector<MirrorMap<3>> maps_;          // each plane's reflection, then the compound images
+  std::vector<int> node_map_;               // per mesh node: the map it is the image under (-1: real)
+  std::vector<int> triangle_map_;           // per mesh triangle: the map (-1: real)
+  std::vector<int> sheet_of_triangle_;      // per mesh triangle: its connected piece (a node id)
   std::vector<double> area_;                // per real node (m^2)
   double clearance_ = 0.0;
   TriangleMesh mesh_;

@@ -40,6 +40,8 @@ class RunOutput {
       series_.add_column(fmt::format("plate_{}/force", k), D);
       series_.add_column(fmt::format("plate_{}/displacement", k));
       series_.add_column(fmt::format("plate_{}/velocity", k));
+      // The gauge pressure driving the plate: prescribed + the common level of plates_never_pull.
+      series_.add_column(fmt::format("plate_{}/drive_pressure", k));
     }
     series_.add_column("lost_particles");
     if (interface_) {
@@ -121,6 +123,7 @@ class RunOutput {
       for (int d = 0; d < D; ++d) row.push_back(solver.body_forces()[k + 1][d]);
       row.push_back(solver.plates()[k].displacement);
       row.push_back(solver.plates()[k].velocity);
+      row.push_back(solver.plates()[k].pressure(solver.time()) + solver.plate_pressure_level());
     }
     row.push_back(static_cast<double>(solver.lost_count()));
     if (interface_) {

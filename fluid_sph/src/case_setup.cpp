@@ -188,6 +188,13 @@ FluidSetup<D> fluid_setup_from_case(const cases::Case& c, const std::filesystem:
     }
     setup.plates.push_back(plate);
   }
+  s.plates_never_pull = f.plates_never_pull();
+  s.plate_pressure_floor = f.plate_pressure_floor_mmhg() * kPascalPerMmHg;
+  if (s.plates_never_pull && setup.plates.empty())
+    in.fail("plates_never_pull", "= true, but the case has no plates: allowed only with at least one entry in fluid.plates");
+  if (!s.plates_never_pull && f.plate_pressure_floor_mmhg() != 0)
+    in.fail("plate_pressure_floor_mmHg", fmt::format("= {}, but plates_never_pull is false: set plates_never_pull: true or remove it",
+                                                     f.plate_pressure_floor_mmhg()));
 
   const auto& pr = f.probes();
   for (int k = 0; k < pr.pressure_points_size(); ++k)

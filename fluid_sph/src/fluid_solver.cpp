@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -410,10 +411,11 @@ void FluidSolver<D>::step() {
     surface_force_time_ += dt;
   }
 
+  const double plate_level = settings_.background_pressure + plate_pressure_level(time_);
   for (std::size_t k = 0; k < plates_.size(); ++k) {
     auto& plate = plates_[k];
     plate.fluid_force = body_forces_[k + 1];
-    plate.acceleration = plate.acceleration_at(time_, plate.fluid_force, settings_.background_pressure);
+    plate.acceleration = plate.acceleration_at(time_, plate.fluid_force, plate_level);
     plate.velocity += 0.5 * dt * plate.acceleration;
   }
 
@@ -453,6 +455,14 @@ void FluidSolver<D>::step() {
   if (settings_.shifting > 0) shift_particles(dt);
   ++steps_;
   choose_time_step();
+}
+
+template <int D>
+double FluidSolver<D>::plate_pressure_level(double t) const {
+  if (!settings_.plates_never_pull || plates_.empty()) return 0.0;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const auto& plate : plates_) lowest = std::min(lowest, plate.pressure(t));
+  return std::max(0.0, settings_.plate_pressure_floor - (settings_.background_pressure + lowest));
 }
 
 template <int D>

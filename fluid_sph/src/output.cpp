@@ -62,7 +62,7 @@ void SnapshotWriter<D>::write(const FluidSolver<D>& solver) {
   std::vector<float> pressure(n), density(n);
   std::vector<int> kind(n);
   std::vector<unsigned> id(n);
-  const double background = solver.settings().background_pressure;
+  const double background = solver.settings().background_pressure + solver.plate_pressure_level();
   std::size_t j = 0;
   for (const std::size_t i : written) {
     for (int d = 0; d < D; ++d) {

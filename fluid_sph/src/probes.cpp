@@ -62,7 +62,7 @@ double pressure_at(const FluidSolver<D>& solver, const Vec<D>& x) {
       sums[1] += w * p.pressure[i];
     }
     sum_over_ranks<D>(solver, sums);
-    return sums[0] > 0 ? sums[1] / sums[0] - s.background_pressure : 0.0;
+    return sums[0] > 0 ? sums[1] / sums[0] - s.background_pressure - solver.plate_pressure_level() : 0.0;
   });
 }
 

@@ -161,5 +161,24 @@ TEST(CaseSetup, HexPrismFillIsReadAndChecked) {
   }
 }
 
+TEST(CaseSetup, PlatesNeverPullIsReadAndChecked) {
+  std::string text = kChannel;
+  text.replace(text.find("  probes {"), 0, "  plates_never_pull: true\n  plate_pressure_floor_mmHg: 2\n");
+  const FluidSetup<2> setup = fluid_setup_from_case<2>(parse_case_text(text, "channel.textproto"), "channel.textproto");
+  EXPECT_TRUE(setup.settings.plates_never_pull);
+  EXPECT_NEAR(setup.settings.plate_pressure_floor, 2 * 133.322387415, 1e-9);
+
+  std::string floor_only = kChannel;
+  floor_only.replace(floor_only.find("  probes {"), 0, "  plate_pressure_floor_mmHg: 2\n");
+  try {
+    fluid_setup_from_case<2>(parse_case_text(floor_only, "channel.textproto"), "channel.textproto");
+    FAIL() << "expected a CaseError";
+  } catch (const CaseError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("channel.textproto: field 'fluid.plate_pressure_floor_mmHg' = 2, but plates_never_pull is false"),
+              std::string::npos) << what;
+  }
+}
+
 }  // namespace
 }  // namespace valvefsi::fluid

@@ -31,6 +31,15 @@ struct FluidSettings {
   // gradient but keeps the pair forces repulsive where the gauge pressure is negative, which
   // suppresses the tensile instability; probes, output and plate loads report p - background.
   double background_pressure = 0.0;
+  // Plates that never pull (issue 7): at every instant all plates' prescribed pressures are
+  // raised by one common level, the least that keeps the lowest plate's absolute pressure
+  // (prescribed + background) at or above plate_pressure_floor. The flow is driven by pressure
+  // differences only, so it is unchanged, but no plate is driven into tension the blood cannot
+  // hold (a plate driven below the fluid's zero pulls away from it and flies off). The fluid
+  // carries the level as a real compression, Delta rho / rho0 = level / (rho0 c0^2); pressure
+  // probes and snapshots report p - background - level (the waveform's reference).
+  bool plates_never_pull = false;
+  double plate_pressure_floor = 0.0;  // Pa
   Vec<D> gravity{};                     // body acceleration (m/s^2)
   // Particle shifting (Skillen et al. 2013 form): each step a fluid particle moves by
   // -A h U dt grad C, with C the kernel sum, U the largest fluid speed and A this

@@ -93,6 +93,11 @@ class FluidSolver {
   const Particles<D>& particles() const { return particles_; }
   const CellGrid<D>& grid() const { return grid_; }
   const std::vector<PressurePlate<D>>& plates() const { return plates_; }
+  // The common level added to every plate's prescribed pressure at time t (Pa): with
+  // settings().plates_never_pull the least that keeps every plate's absolute pressure at or
+  // above settings().plate_pressure_floor, else 0.
+  double plate_pressure_level(double t) const;
+  double plate_pressure_level() const { return plate_pressure_level(time_); }
 
   // Force of the fluid on body k (0: fixed walls, k: plates[k-1]) at the last step that
   // computed it: plates every step; the fixed walls only after request_body_forces() or

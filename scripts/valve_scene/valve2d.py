@@ -58,6 +58,8 @@ LEAFLET_SHAPES = ("flat", "belly")
 # (fsi.valve2d_first_10ms bounds it at 20 N/m) and the xcoarse taps spike by ~100 mmHg in the
 # opening; session 4 ran the xcoarse cycles both ways (docs/fsi-2d.md). Off until one is fixed.
 BACKGROUND_PRESSURE_2D = False
+# Session 5: without it, fluid.plates_never_pull raises both plates' pressures by one common level
+# whenever the ventricular one would go below 0, so no plate pulls on the blood (docs/fluid_sph.md).
 # The fluid's CFL number and the coupling window (a multiple of the mu = 1 window), from the
 # stability map (docs/stability-map.md, session 5): with the leaflets two-sided along their whole
 # length (the sinus behind them), the coarse valve at CFL 0.2 and the mu = 1 window (6.5 us) runs
@@ -322,8 +324,11 @@ def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Chann
            "  # plus the plates' offset below, so neither plate starts with a step load",
            f"  background_pressure: {background_Pa:.9g}"] if background else
           [f"  # no background pressure: gauge 0 = the aortic pressure at opening ({offset:g} mmHg), the",
-           "  # plates' offset below; the diastolic ventricle runs at negative gauge (docs/fsi-2d.md)",
-           "  background_pressure: 0"]),
+           "  # plates' offset below",
+           "  background_pressure: 0",
+           "  # the diastolic ventricle would run at -75 mmHg gauge and its plate pull away from the",
+           "  # blood: both plates are raised together so the lower one stays at 0 (docs/fsi-2d.md)",
+           "  plates_never_pull: true"]),
         f"  domain_lower: {_vec([channel_start - margin, -half - margin])}",
         f"  domain_upper: {_vec([channel_end + margin, half + margin])}",
         f"  # the stent faces y = +-R lie on lattice planes (the channel walls {wall_offset * 1e3:.2g} mm off them)",

@@ -126,7 +126,18 @@ int run_case_at_rest(const std::string& case_file, const std::string& surface_fi
             length = std::sqrt(length);
             if (length > 0.05 * dp)
               for (int d = 0; d < 3; ++d) shift[d] *= 0.05 * dp / length;
-            if (solver.immersed_surface()->accept_shift(p, i, shift)) {
+            // Never towards a mirror plane within 0.4 dp (the fill's margin): a particle there
+            // sits almost on its own image.
+            bool off_planes = true;
+            for (const auto& plane : solver.settings().mirror_planes) {
+              double before = 0, after = 0;
+              for (int d = 0; d < 3; ++d) {
+                before += (x[d] - plane.point[d]) * plane.normal[d];
+                after += (x[d] + shift[d] - plane.point[d]) * plane.normal[d];
+              }
+              off_planes = off_planes && !(after < 0.4 * dp && after < before);
+            }
+            if (off_planes && solver.immersed_surface()->accept_shift(p, i, shift)) {
               for (int d = 0; d < 3; ++d) x[d] += shift[d];
               largest_shift = std::max(largest_shift, std::min(length, 0.05 * dp));
             }

@@ -51,7 +51,7 @@ int run_standalone(const valvefsi::cases::Case& c, const std::filesystem::path& 
         solver.advance_to(run_output.next_due());
       }
     }
-  } catch (const TimeStepCollapse&) {
+  } catch (const FluidStop&) {
     run_output.write_last_state(solver);  // every rank sees the collapse (the step is common)
     throw;
   }

@@ -252,7 +252,7 @@ int run_coupled(const cases::Case& c, const std::filesystem::path& case_file, co
       solver.reset_surface_force_average();
       try {
         solver.advance_to(window.end());
-      } catch (const TimeStepCollapse&) {
+      } catch (const FluidStop&) {
         run_output.write_last_state(solver, last_total);  // every rank sees the collapse (the step is common)
         throw;
       }

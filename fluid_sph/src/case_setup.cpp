@@ -99,6 +99,7 @@ FluidSetup<D> fluid_setup_from_case(const cases::Case& c, const std::filesystem:
   s.cfl = f.cfl();
   s.max_density_deviation = f.max_density_deviation();
   s.min_time_step_ratio = f.min_time_step_ratio();
+  s.max_leak_fraction = f.max_leak_fraction();
   if (f.max_time_step() > 0) s.max_time_step = f.max_time_step();
   s.domain_lower = in.vec<D>(f.domain_lower(), "domain_lower");
   s.domain_upper = in.vec<D>(f.domain_upper(), "domain_upper");

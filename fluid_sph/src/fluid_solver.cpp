@@ -79,6 +79,8 @@ FluidSolver<D>::FluidSolver(const FluidSettings<D>& settings, Particles<D> parti
     }
   }
   refresh_mirror_images();
+  initial_fluid_count_ = particles_.count(Kind::fluid);
+  leak_limit_ = static_cast<std::size_t>(std::floor(settings_.max_leak_fraction * static_cast<double>(initial_fluid_count_)));
   lost_ = grid_.wrap_and_mark_lost(particles_);
   grid_.sort(particles_);
   update_owned_range();
@@ -454,6 +456,7 @@ void FluidSolver<D>::step() {
   lost_density_ += out_of_range;
   if (settings_.shifting > 0) shift_particles(dt);
   ++steps_;
+  if (surface_) check_leaks();  // the state is complete: it can be written
   choose_time_step();
 }
 
@@ -549,6 +552,38 @@ void FluidSolver<D>::choose_time_step() {
         time_, dt_, s.min_time_step_ratio, dt_at_rest, limit, max_speed_, surface_ ? surface_->max_node_speed() : 0.0,
         max_acceleration_, describe_extremes()));
   }
+}
+
+template <int D>
+void FluidSolver<D>::check_leaks() const {
+  const ImmersedSurfaceCounters counters = surface_->counters();
+  if (counters.leaks <= leak_limit_) return;
+  // The counters carry no positions: name the fastest fluid particle near the surface, the
+  // likeliest to have gone through it.
+  const auto& p = particles_;
+  double best = -1.0;
+  std::size_t at = 0;
+  for (std::size_t i = owned_begin_; i < owned_end_ && i < near_surface_.size(); ++i) {
+    if (p.kind[i] != Kind::fluid || !near_surface_[i]) continue;
+    double v2 = 0;
+    for (int d = 0; d < D; ++d) v2 += static_cast<double>(p.velocity[d][i]) * p.velocity[d][i];
+    if (v2 > best) {
+      best = v2;
+      at = i;
+    }
+  }
+  std::string where = "no fluid particle is near the surface now";
+  if (best >= 0)
+    where = fmt::format("the fastest fluid particle near the surface is particle {} at x = ({:.6g}, {:.6g}{}) m, speed {:.3g} m/s "
+                        "(the surface model counts leaks but does not say which particles)",
+                        p.id[at], p.position[0][at], p.position[1][at], D == 3 ? fmt::format(", {:.6g}", p.position[D - 1][at]) : std::string(),
+                        std::sqrt(best));
+  throw LeakLimitExceeded(fmt::format(
+      "fluid leaks through the leaflets: {} particle(s) found on the wrong side of the immersed surface without a put-back "
+      "by t = {:.6g} s (step {}), above fluid.max_leak_fraction = {:g} of the {} fluid particles ({} allowed; {} put back so "
+      "far); {}; the leaflet moves too far in a step for the put-back or has a gap: lower the coupling window or the fluid "
+      "CFL, refine dp, or raise fluid.max_leak_fraction to go on",
+      counters.leaks, time_, steps_, settings_.max_leak_fraction, initial_fluid_count_, leak_limit_, counters.corrections, where));
 }
 
 template <int D>

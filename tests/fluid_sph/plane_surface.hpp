@@ -1,7 +1,8 @@
 #pragma once
 // A test double of an immersed surface: the fixed plane x = x0 (a line in 2D) that separates
 // the particles on its two sides. Particles that cross it in a step are put back (to their x
-// at the step's start, normal velocity removed) and counted. With `mirror`, each side also
+// at the step's start, normal velocity removed) and counted (or, with put_back = false, left
+// where they are and counted as leaks). With `mirror`, each side also
 // sees the mirror images of its own near-plane particles (pressure and continuity terms), a
 // minimal wall condition so that the fluid rests against the plane instead of piling into it.
 #include <atomic>
@@ -38,6 +39,10 @@ class PlaneSurface final : public ImmersedSurfaceModel<D> {
     if (!block_) return;
     for (std::size_t i = 0; i < p.size() && i < side_.size(); ++i) {
       if (p.kind[i] != Kind::fluid || (p.position[0][i] < x0_) == side_[i]) continue;
+      if (!put_back) {  // a model that misses the crossing: the particle leaked
+        ++counters_.leaks;
+        continue;
+      }
       p.position[0][i] = start_x_[i];  // back to where the step began, stopped along x
       p.velocity[0][i] = 0.0f;
       ++counters_.corrections;
@@ -99,6 +104,8 @@ class PlaneSurface final : public ImmersedSurfaceModel<D> {
   void save_checkpoint() override {}
   void restore_checkpoint() override {}
 
+  // false: crossings are not put back but counted as leaks (a model that lost track).
+  bool put_back = true;
   long classify_calls = 0;
   long accept_shift_calls = 0;
   mutable std::atomic<long> blocked_calls{0};  // the pair loops call blocked() from threads

@@ -22,12 +22,25 @@
 
 namespace valvefsi::fluid {
 
-// Thrown when the time step falls below FluidSettings::min_time_step_ratio of the step at rest;
-// what() says which limit, and where the fastest and the most accelerated particles are. The
+// A run the solver stops itself: what() says what failed, when, where and what to change. The
 // solver's state is that of the last completed step (finite), so it can still be written.
-class TimeStepCollapse : public std::runtime_error {
+class FluidStop : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+// Thrown when the time step falls below FluidSettings::min_time_step_ratio of the step at rest;
+// what() says which limit, and where the fastest and the most accelerated particles are.
+class TimeStepCollapse : public FluidStop {
+ public:
+  using FluidStop::FluidStop;
+};
+
+// Thrown when the immersed surface's leak count (particles found on the wrong side of a leaflet
+// without a put-back) exceeds FluidSettings::max_leak_fraction of the fluid particles.
+class LeakLimitExceeded : public FluidStop {
+ public:
+  using FluidStop::FluidStop;
 };
 
 template <int D>
@@ -78,7 +91,8 @@ class FluidSolver {
   // split, the lost particles at the end.
   std::pair<std::size_t, std::size_t> owned_range() const { return {owned_begin_, owned_end_}; }
 
-  // Advances by time_step() and then chooses the next time step.
+  // Advances by time_step() and then chooses the next time step. Throws FluidStop (a
+  // TimeStepCollapse or a LeakLimitExceeded) when the run cannot go on.
   void step();
   // Steps until time() >= end_time (the last step is shortened to land on it).
   void advance_to(double end_time);
@@ -116,6 +130,7 @@ class FluidSolver {
   void add_mirror_images();
   void update_owned_range();
   std::string describe_extremes() const;
+  void check_leaks() const;
   PairFilter<D> pair_filter() const;
 
   struct Checkpoint;
@@ -145,6 +160,8 @@ class FluidSolver {
   std::shared_ptr<Checkpoint> checkpoint_;
   std::unique_ptr<SlabDecomposition<D>> slabs_;
   std::size_t owned_begin_ = 0, owned_end_ = 0;
+  std::size_t initial_fluid_count_ = 0;
+  std::size_t leak_limit_ = 0;  // leaks allowed: max_leak_fraction x the fluid particles at the start
 };
 
 }  // namespace valvefsi::fluid

@@ -174,6 +174,83 @@ TEST(ThinWallCheckpoint, ThreeDimensionalPassAfterRestoreRepeatsTheFirst) {
   check_repeated_windows<3>(std::move(r), 2);
 }
 
+// A "lively" field for the continuity tests: a block of fluid jittered off its lattice (no
+// symmetry), with random velocities and densities, in a domain of +-2.5 half-widths.
+template <int D>
+std::pair<FluidSettings<D>, Particles<D>> lively_field(double half_width, unsigned seed) {
+  FluidSettings<D> s;
+  s.particle_spacing = 0.005;
+  s.sound_speed = 20.0;
+  s.artificial_viscosity = 0.02;
+  s.gravity[D - 1] = -9.81;
+  for (int d = 0; d < D; ++d) {
+    s.domain_lower[d] = -half_width * (D == 2 ? 2.0 : 1.5);
+    s.domain_upper[d] = half_width * (D == 2 ? 2.0 : 1.5);
+  }
+  SceneGeometry<D> scene;
+  Vec<D> lower, upper;
+  for (int d = 0; d < D; ++d) lower[d] = -half_width, upper[d] = half_width;
+  scene.fluid.push_back({lower, upper, {}, [](const Vec<D>&) { return 0.0; }});
+  Particles<D> base = fill_particles<D>(scene, s);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (std::size_t i = 0; i < base.size(); ++i) {
+    for (int d = 0; d < D; ++d) {
+      base.position[d][i] += 0.3 * s.particle_spacing * u(rng);  // no lattice symmetry
+      base.velocity[d][i] = 0.2f * u(rng);
+      base.viscous_velocity[d][i] = base.velocity[d][i];
+    }
+    base.density_excess[i] = 2.0f * u(rng);
+  }
+  return {s, base};
+}
+
+// The wall's rates on every particle (by particle id) after its nodes moved by `ulps` ulps.
+template <int D, class Model>
+std::vector<double> rates_after_nudge(const FluidSettings<D>& s, const Particles<D>& base,
+                                      const ImmersedSurfaceGeometry<D>& g, int ulps) {
+  Particles<D> p = base;
+  CellGrid<D> grid(s.domain_lower, s.domain_upper, s.support_radius(), s.periodic);
+  grid.wrap_and_mark_lost(p);
+  grid.sort(p);
+  Model model(g, s, {});
+  std::vector<Vec<D>> x1 = g.nodes, v1(g.nodes.size(), Vec<D>{});
+  for (auto& x : x1)
+    for (int d = 0; d < D; ++d)
+      for (int k = 0; k < ulps; ++k) x[d] = std::nextafter(x[d], 1.0);
+  model.set_window_target(0.002, x1, v1);
+  model.move_to(0.002);
+  model.classify(p);
+  update_fluid_pressure<D>(p, s);
+  model.update_surface_states(p, grid);
+  for (int d = 0; d < D; ++d) std::fill(p.acceleration[d].begin(), p.acceleration[d].end(), 0.0f);
+  model.add_surface_rates(p);
+  std::vector<double> a(D * p.size());
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (int d = 0; d < D; ++d) a[D * p.id[i] + static_cast<std::size_t>(d)] = p.acceleration[d][i];
+  return a;
+}
+
+// Moves the wall by 1-16 ulps and expects no rate to change by more than `bound` of the largest.
+template <int D, class Model>
+void expect_rates_continuous(const FluidSettings<D>& s, const Particles<D>& base, const ImmersedSurfaceGeometry<D>& g,
+                             double bound) {
+  const auto a0 = rates_after_nudge<D, Model>(s, base, g, 0);
+  double scale = 0.0;
+  for (const double v : a0) scale = std::max(scale, std::abs(v));
+  ASSERT_GT(scale, 0.0);
+  for (int ulps = 1; ulps <= 16; ++ulps) {
+    const auto a = rates_after_nudge<D, Model>(s, base, g, ulps);
+    double worst = 0.0;
+    std::size_t at = 0;
+    for (std::size_t k = 0; k < a.size(); ++k)
+      if (std::abs(a[k] - a0[k]) > worst) worst = std::abs(a[k] - a0[k]), at = k / D;
+    std::printf("%dD continuity: %2d ulps: largest change %.3g (%.3g of the largest rate %.3g), particle id %zu\n", D,
+                ulps, worst, worst / scale, scale, at);
+    EXPECT_LT(worst, bound * scale) << ulps << " ulps";
+  }
+}
+
 // The wall's rates on the fluid barely move when the wall moves by 1 to 16 ulps, also for
 // particles beyond a free end, whose virtual lattice has a column on the ray through the end
 // node: that column's shadow test flipped with round-off (jumps of 5-10 % of the largest
@@ -182,63 +259,12 @@ TEST(ThinWallCheckpoint, ThreeDimensionalPassAfterRestoreRepeatsTheFirst) {
 // ray through an interior node slipping between its two segments by round-off (the segment
 // test now has a margin along the wall); now no change at all: the bound is 0.1 %.
 TEST(ThinWallContinuity, RatesAreContinuousInTheWallPositionAtFreeEnds) {
-  FluidSettings<2> s;
-  s.particle_spacing = 0.005;
-  s.sound_speed = 20.0;
-  s.artificial_viscosity = 0.02;
-  s.gravity = {0.0, -9.81};
-  s.domain_lower = {-0.1, -0.1};
-  s.domain_upper = {0.1, 0.1};
-  SceneGeometry<2> scene;
-  scene.fluid.push_back({{-0.05, -0.05}, {0.05, 0.05}, {}, [](const Vec<2>&) { return 0.0; }});
-  Particles<2> base = fill_particles<2>(scene, s);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  for (std::size_t i = 0; i < base.size(); ++i) {
-    for (int d = 0; d < 2; ++d) {
-      base.position[d][i] += 0.3 * s.particle_spacing * u(rng);  // no lattice symmetry
-      base.velocity[d][i] = 0.2f * u(rng);
-      base.viscous_velocity[d][i] = base.velocity[d][i];
-    }
-    base.density_excess[i] = 2.0f * u(rng);
-  }
+  const auto [s, base] = lively_field<2>(0.05, 11);
   ImmersedSurfaceGeometry<2> g;
   g.nodes = {{-0.0301, -0.0199}, {-0.0101, 0.0003}, {-0.0049, 0.0201}, {0.0302, 0.0148}, {0.0099, -0.0152}};
   g.cells = {0, 1, 1, 2, 3, 4};
   g.node_thickness.assign(5, 2.5e-4);
-  auto accelerations = [&](int ulps) {
-    Particles<2> p = base;
-    CellGrid<2> grid(s.domain_lower, s.domain_upper, s.support_radius(), s.periodic);
-    grid.wrap_and_mark_lost(p);
-    grid.sort(p);
-    ThinWallModel2D model(g, s, {});
-    std::vector<Vec2> x1 = g.nodes, v1(g.nodes.size(), Vec2{0.0, 0.0});
-    for (auto& x : x1)
-      for (int d = 0; d < 2; ++d)
-        for (int k = 0; k < ulps; ++k) x[d] = std::nextafter(x[d], 1.0);
-    model.set_window_target(0.002, x1, v1);
-    model.move_to(0.002);
-    model.classify(p);
-    update_fluid_pressure<2>(p, s);
-    model.update_surface_states(p, grid);
-    for (int d = 0; d < 2; ++d) std::fill(p.acceleration[d].begin(), p.acceleration[d].end(), 0.0f);
-    model.add_surface_rates(p);
-    std::vector<double> a(2 * p.size());  // by particle id
-    for (std::size_t i = 0; i < p.size(); ++i)
-      for (int d = 0; d < 2; ++d) a[2 * p.id[i] + static_cast<std::size_t>(d)] = p.acceleration[d][i];
-    return a;
-  };
-  const auto a0 = accelerations(0);
-  double scale = 0.0;
-  for (const double v : a0) scale = std::max(scale, std::abs(v));
-  ASSERT_GT(scale, 0.0);
-  for (int ulps = 1; ulps <= 16; ++ulps) {
-    const auto a = accelerations(ulps);
-    double worst = 0.0;
-    for (std::size_t k = 0; k < a.size(); ++k) worst = std::max(worst, std::abs(a[k] - a0[k]));
-    std::printf("2D continuity: %2d ulps: largest change %.3g (%.3g of the largest rate %.3g)\n", ulps, worst, worst / scale, scale);
-    EXPECT_LT(worst, 1e-3 * scale) << ulps << " ulps";
-  }
+  expect_rates_continuous<2, ThinWallModel2D>(s, base, g, 1e-3);
 }
 
 // The same in 3D (docs/thin-leaflet.md, "3D", grazing ray): beyond a free edge the virtual
@@ -247,26 +273,7 @@ TEST(ThinWallContinuity, RatesAreContinuousInTheWallPositionAtFreeEnds) {
 // the crossing test they switch on or off with round-off. Two tilted leaflets (3 x 3 nodes,
 // eight triangles each, every edge of the outline free) in a lively field, moved by 1-16 ulps.
 TEST(ThinWallContinuity, ThreeDimensionalRatesAreContinuousInTheWallPositionAtFreeEdges) {
-  FluidSettings<3> s;
-  s.particle_spacing = 0.005;
-  s.sound_speed = 20.0;
-  s.artificial_viscosity = 0.02;
-  s.gravity = {0.0, 0.0, -9.81};
-  s.domain_lower = {-0.06, -0.06, -0.06};
-  s.domain_upper = {0.06, 0.06, 0.06};
-  SceneGeometry<3> scene;
-  scene.fluid.push_back({{-0.04, -0.04, -0.04}, {0.04, 0.04, 0.04}, {}, [](const Vec<3>&) { return 0.0; }});
-  Particles<3> base = fill_particles<3>(scene, s);
-  std::mt19937 rng(17);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  for (std::size_t i = 0; i < base.size(); ++i) {
-    for (int d = 0; d < 3; ++d) {
-      base.position[d][i] += 0.3 * s.particle_spacing * u(rng);  // no lattice symmetry
-      base.velocity[d][i] = 0.2f * u(rng);
-      base.viscous_velocity[d][i] = base.velocity[d][i];
-    }
-    base.density_excess[i] = 2.0f * u(rng);
-  }
+  const auto [s, base] = lively_field<3>(0.04, 17);
   ImmersedSurfaceGeometry<3> g;
   g.nodes_per_cell = 3;
   // Leaflet k: 3 x 3 nodes on a tilted, slightly warped square of side ~0.03 m.
@@ -289,45 +296,7 @@ TEST(ThinWallContinuity, ThreeDimensionalRatesAreContinuousInTheWallPositionAtFr
       }
   }
   g.node_thickness.assign(g.nodes.size(), 2.5e-4);
-  auto accelerations = [&](int ulps) {
-    Particles<3> p = base;
-    CellGrid<3> grid(s.domain_lower, s.domain_upper, s.support_radius(), s.periodic);
-    grid.wrap_and_mark_lost(p);
-    grid.sort(p);
-    ThinWallModel3D model(g, s, {});
-    std::vector<Vec3> x1 = g.nodes, v1(g.nodes.size(), Vec3{0.0, 0.0, 0.0});
-    for (auto& x : x1)
-      for (int d = 0; d < 3; ++d)
-        for (int k = 0; k < ulps; ++k) x[d] = std::nextafter(x[d], 1.0);
-    model.set_window_target(0.002, x1, v1);
-    model.move_to(0.002);
-    model.classify(p);
-    update_fluid_pressure<3>(p, s);
-    model.update_surface_states(p, grid);
-    for (int d = 0; d < 3; ++d) std::fill(p.acceleration[d].begin(), p.acceleration[d].end(), 0.0f);
-    model.add_surface_rates(p);
-    std::vector<double> a(3 * p.size());  // by particle id
-    for (std::size_t i = 0; i < p.size(); ++i)
-      for (int d = 0; d < 3; ++d) a[3 * p.id[i] + static_cast<std::size_t>(d)] = p.acceleration[d][i];
-    return a;
-  };
-  const auto a0 = accelerations(0);
-  double scale = 0.0;
-  for (const double v : a0) scale = std::max(scale, std::abs(v));
-  ASSERT_GT(scale, 0.0);
-  for (int ulps = 1; ulps <= 16; ++ulps) {
-    const auto a = accelerations(ulps);
-    double worst = 0.0;
-    std::size_t at = 0;
-    for (std::size_t k = 0; k < a.size(); ++k)
-      if (std::abs(a[k] - a0[k]) > worst) {
-        worst = std::abs(a[k] - a0[k]);
-        at = k / 3;
-      }
-    std::printf("3D continuity: %2d ulps: largest change %.3g (%.3g of the largest rate %.3g), particle id %zu\n", ulps, worst,
-                worst / scale, scale, at);
-    EXPECT_LT(worst, 1e-2 * scale) << ulps << " ulps";
-  }
+  expect_rates_continuous<3, ThinWallModel3D>(s, base, g, 1e-2);
 }
 
 }  // namespace

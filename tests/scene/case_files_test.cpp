@@ -108,8 +108,11 @@ TEST(SceneCaseFiles, TwoDimensionalCasesLoad) {
         jet_core = jet_core || (plane.name() == "jet_core_15mm" && plane.radius() > 0.0);
       EXPECT_TRUE(jet_core);
       EXPECT_TRUE(f.has_thin_walls());
+      // the stable 2D setting of docs/stability-map.md: a window of at most mu = 2 for the
+      // 0.25 mm, 1100 kg/m^3 leaflet at c0 = 20 m/s (13 us), the fluid sub-cycling at CFL 0.1
       EXPECT_GT(c.coupling().window_size(), 0.0);
-      EXPECT_LE(c.coupling().window_size(), 1e-5);
+      EXPECT_LE(c.coupling().window_size(), 1.3e-5 * (1.0 + 1e-9));
+      EXPECT_LE(f.cfl(), 0.1);
     }
   }
   EXPECT_EQ(found, 12);

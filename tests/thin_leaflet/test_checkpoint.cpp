@@ -19,6 +19,7 @@
 #include "valvefsi/fluid/geometry.hpp"
 #include "valvefsi/fluid/interactions.hpp"
 #include "valvefsi/fluid/thin_wall/scenes_2d.hpp"
+#include "valvefsi/fluid/thin_wall/solver_run_2d.hpp"
 #include "valvefsi/fluid/thin_wall/scenes_3d.hpp"
 #include "valvefsi/fluid/thin_wall/thin_wall_model.hpp"
 #include "valvefsi/fluid/thin_wall/thin_wall_model_3d.hpp"
@@ -86,16 +87,7 @@ CoupledFluid<2> plate_run() {
   auto c = std::make_shared<ThinWallCase2D>(oscillating_plate_box(0.02, plate));
   c->fluid.shifting = 1.0;
   c->motion(0.0, c->walls);
-  ImmersedSurfaceGeometry<2> g;
-  for (const Polyline& w : c->walls) {
-    const auto first = static_cast<std::uint32_t>(g.nodes.size());
-    g.nodes.insert(g.nodes.end(), w.position.begin(), w.position.end());
-    for (std::uint32_t k = 0; k + 1 < w.node_count(); ++k) {
-      g.cells.push_back(first + k);
-      g.cells.push_back(first + k + 1);
-    }
-  }
-  g.node_thickness.assign(g.nodes.size(), 0.0);
+  const ImmersedSurfaceGeometry<2> g = surface_of(c->walls);
   CoupledFluid<2> r;
   r.window_size = 2e-3;
   r.solver = std::make_unique<FluidSolver<2>>(c->fluid, fill_particles<2>(c->scene, c->fluid), std::vector<PressurePlate<2>>{},

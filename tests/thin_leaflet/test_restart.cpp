@@ -14,6 +14,7 @@
 #include "valvefsi/fluid/fluid_solver.hpp"
 #include "valvefsi/fluid/geometry.hpp"
 #include "valvefsi/fluid/thin_wall/scenes_2d.hpp"
+#include "valvefsi/fluid/thin_wall/solver_run_2d.hpp"
 #include "valvefsi/fluid/thin_wall/scenes_3d.hpp"
 #include "valvefsi/fluid/thin_wall/thin_wall_model.hpp"
 #include "valvefsi/fluid/thin_wall/thin_wall_model_3d.hpp"
@@ -125,16 +126,7 @@ TEST(ThinWallRestart, TwoDimensionalModelContinuesBitForBit) {
   c.fluid.shifting = 1.0;
   ASSERT_TRUE(c.motion);
   c.motion(0.0, c.walls);
-  ImmersedSurfaceGeometry<2> g;
-  for (const Polyline& w : c.walls) {
-    const auto first = static_cast<std::uint32_t>(g.nodes.size());
-    g.nodes.insert(g.nodes.end(), w.position.begin(), w.position.end());
-    for (std::uint32_t k = 0; k + 1 < w.node_count(); ++k) {
-      g.cells.push_back(first + k);
-      g.cells.push_back(first + k + 1);
-    }
-  }
-  g.node_thickness.assign(g.nodes.size(), 0.0);
+  const ImmersedSurfaceGeometry<2> g = surface_of(c.walls);
   auto make_model = [&] { return std::make_unique<ThinWallModel2D>(g, c.fluid, c.wall_settings); };
   auto make_run = [&](std::unique_ptr<ThinWallModel2D> model) {
     WindowedRun<2> r;

@@ -6,14 +6,9 @@
 
 namespace valvefsi::fluid::thin_wall {
 
-ThinWallSolverRun2D::ThinWallSolverRun2D(ThinWallCase2D c, double window)
-    : motion_(std::move(c.motion)), scratch_(c.walls), window_(window) {
-  if (!(window > 0)) throw std::invalid_argument("ThinWallSolverRun2D: window = " + std::to_string(window) + " s: allowed > 0");
-  if (c.walls.empty()) throw std::invalid_argument("ThinWallSolverRun2D: the case has no thin wall");
-  if (motion_) motion_(0.0, c.walls);
-  // The walls as the coupler would send them: one node list, segments along each wall.
+ImmersedSurfaceGeometry<2> surface_of(const std::vector<Polyline>& walls) {
   ImmersedSurfaceGeometry<2> g;
-  for (const Polyline& w : c.walls) {
+  for (const Polyline& w : walls) {
     const auto first = static_cast<std::uint32_t>(g.nodes.size());
     g.nodes.insert(g.nodes.end(), w.position.begin(), w.position.end());
     for (std::uint32_t k = 0; k + 1 < w.node_count(); ++k) {
@@ -22,6 +17,15 @@ ThinWallSolverRun2D::ThinWallSolverRun2D(ThinWallCase2D c, double window)
     }
   }
   g.node_thickness.assign(g.nodes.size(), 0.0);
+  return g;
+}
+
+ThinWallSolverRun2D::ThinWallSolverRun2D(ThinWallCase2D c, double window)
+    : motion_(std::move(c.motion)), scratch_(c.walls), window_(window) {
+  if (!(window > 0)) throw std::invalid_argument("ThinWallSolverRun2D: window = " + std::to_string(window) + " s: allowed > 0");
+  if (c.walls.empty()) throw std::invalid_argument("ThinWallSolverRun2D: the case has no thin wall");
+  if (motion_) motion_(0.0, c.walls);
+  const ImmersedSurfaceGeometry<2> g = surface_of(c.walls);
   auto model = std::make_unique<ThinWallModel2D>(g, c.fluid, c.wall_settings);
   model_ = model.get();
   solver_ = std::make_unique<FluidSolver<2>>(c.fluid, fill_particles<2>(c.scene, c.fluid), std::vector<PressurePlate<2>>{},

@@ -11,6 +11,10 @@
 
 namespace valvefsi::fluid::thin_wall {
 
+// The walls as the coupler would send them: one node list, segments along each wall, no
+// thickness.
+ImmersedSurfaceGeometry<2> surface_of(const std::vector<Polyline>& walls);
+
 class ThinWallSolverRun2D {
  public:
   // `window`: length of the motion windows (s); the motion between window ends is the

@@ -11,7 +11,11 @@ when the span holds it, and says which span it came from.
   excursion); needs the curve to pass 90 %;
 - opening_start (s): the 10 % crossing;
 - and, when the span covers a whole first cycle: eoa, rvct, diastolic_force
-  (valve_scene.hemodynamics.analyse_cycle and analysis.valve_events).
+  (valve_scene.hemodynamics.analyse_cycle and analysis.valve_events);
+- peak_strain, peak_stress (3D, from the solid's field snapshots): the robust peak of the max
+  principal log strain and stress (the value exceeded on 1 % of the leaflet's reference area,
+  the largest over the span's snapshots: valve_scene.analysis.robust_peak), so that one corner
+  element cannot decide a comparison between meshes.
 In 2D, extensive quantities are per metre of depth and the radial position is |y|.
 """
 from __future__ import annotations
@@ -32,9 +36,10 @@ REFERENCE_3D_ONLY = {
     "MHGO": {"peak_flow": 14.7e-3 / 60.0, "eoa": 1.50e-4, "diastolic_force": -6.1},
     "Ogden": {"peak_flow": 13.1e-3 / 60.0, "eoa": 1.22e-4, "diastolic_force": -6.9},
 }
-UNITS = {"peak_velocity": "m/s", "peak_flow": "m^2/s (2D) or m^3/s", "pspd_mmHg": "mmHg", "rvot": "s",
+UNITS = {"peak_strain": "1", "peak_stress": "Pa", "peak_velocity": "m/s", "peak_flow": "m^2/s (2D) or m^3/s", "pspd_mmHg": "mmHg", "rvot": "s",
          "opening_start": "s", "eoa": "cm (2D) or cm^2", "rvct": "s", "diastolic_force": "N/m (2D) or N"}
-HEADLINE = ("peak_velocity", "peak_flow", "pspd_mmHg", "rvot", "eoa", "rvct", "diastolic_force")
+HEADLINE = ("peak_velocity", "peak_flow", "pspd_mmHg", "rvot", "eoa", "rvct", "diastolic_force", "peak_strain",
+            "peak_stress")
 
 
 def _smooth(t, y):
@@ -137,6 +142,8 @@ def run_metrics(run_dir: Path, dimension: int = 2, material: str = "MHGO") -> di
                 events = None
     except (OSError, KeyError, FileNotFoundError):
         pass
+    if dimension == 3:
+        out.update(field_peaks(run_dir))
     if series is not None and out.get("span_s", [0, 0])[1] >= 0.95 * 0.8:
         try:
             cycle = hd.analyse_cycle(series, 1, closure_time_s=events.closing_end if events else None)
@@ -145,6 +152,31 @@ def run_metrics(run_dir: Path, dimension: int = 2, material: str = "MHGO") -> di
                 out["diastolic_force"] = cycle.diastolic_force
         except ValueError:
             pass
+    return out
+
+
+def field_peaks(run_dir: Path) -> dict:
+    """{'peak_strain', 'peak_stress'}: robust peaks over the run's field snapshots (none without
+    snapshots)."""
+    from valve_scene.analysis import robust_peak, triangle_areas
+    from valve_scene.solid_results import SolidFields
+    try:
+        fields = SolidFields(run_dir)
+    except (OSError, KeyError, FileNotFoundError):
+        return {}
+    if len(fields.times) == 0:
+        return {}
+    areas = triangle_areas(fields.reference_nodes, fields.triangles)
+    history: dict = {}
+    for k in range(len(fields.times)):
+        for name, values in fields.snapshot(k).items():
+            if name != "position" and len(values) == len(areas):
+                history.setdefault(name, []).append(values)
+    out = {}
+    for metric, name in (("peak_strain", "max_principal_log_strain"), ("peak_stress", "max_principal_stress")):
+        if history.get(name):
+            value, k = robust_peak(history[name], areas)
+            out[metric], out[metric + "_time"] = value, float(fields.times[k])
     return out
 
 

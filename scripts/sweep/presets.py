@@ -6,6 +6,10 @@ spans as short as the question allows (stated in `span`).
 from __future__ import annotations
 
 OPENING_END_S = 0.10
+# FE-only 3D opening: the reference's FE-only leaflets open within ~6 ms of the start of the
+# forward gradient (about 20 ms); 60 ms holds the opening, the open plateau and the peak strain.
+FE_OPENING_END_S = 0.06
+CASES = "../cases/"
 
 PRESETS = {
     # Speed against accuracy: particle spacing x sound speed on the 2D valve's opening.
@@ -53,5 +57,24 @@ PRESETS = {
             + [{"group": "thickness / spacing", "setting": {"thickness_mm": t}} for t in (0.5, 0.125, 0.0625)]
         ),
         "wall_limit_s": 900,
+    },
+    # The model choices of issue 8 item 1 that are a choice of case, FE-only (no fluid, uniform
+    # prescribed pressure), over the opening: sector vs full valve, shell vs hexahedral leaflets,
+    # and the mesh resolution. The finest is the fine sector with shells.
+    "fe-opening-3d": {
+        "scene": "case",
+        "report": "report",
+        "end_time": FE_OPENING_END_S,
+        "span": "FE-only opening, 0-60 ms of the first cycle (uniform prescribed pressure; no fluid)",
+        "runs": (
+            [{"group": "sector shell", "setting": {"case": CASES + f"fe-mhgo-sector-{r}.textproto"}}
+             for r in ("coarse", "medium", "fine")]
+            + [{"group": "full valve shell", "setting": {"case": CASES + "fe-mhgo-full-coarse.textproto"}}]
+            + [{"group": "sector hexahedron",
+                "setting": {"case": CASES + f"fe-mhgo-sector-{r}.textproto", "set:solid.element_family": "HEXAHEDRON"}}
+               for r in ("coarse", "medium")]
+        ),
+        "finest": {"case": CASES + "fe-mhgo-sector-fine.textproto"},
+        "wall_limit_s": 3600,
     },
 }

@@ -18,6 +18,8 @@ SHOWN = [  # (metric, column title, scale, digits)
     ("eoa", "EOA", 1.0, 3),
     ("rvct", "RVCT (ms)", 1e3, 1),
     ("diastolic_force", "diastolic F", 1.0, 2),
+    ("peak_strain", "peak strain", 1.0, 3),
+    ("peak_stress", "peak stress (MPa)", 1e-6, 2),
     ("max_edge_speed", "max edge speed (m/s)", 1.0, 1),   # shown, not a headline metric
 ]
 
@@ -155,7 +157,7 @@ def chart(results: list[dict], path: Path, finest_label: str | None = None, titl
             shown_kinds.add(kind)
             ax.annotate(", ".join(_short(v) for k, v in r["setting"].items() if k in varied), (x, y), fontsize=7,
                         xytext=(3, 3), textcoords="offset points")
-    markers = dict(zip(metrics_module.HEADLINE, "os^vD<>"))
+    markers = dict(zip(metrics_module.HEADLINE, "os^vD<>ph*"))
     plotted = set()
     for r in rows:
         for m, e in r["errors"].items():

@@ -53,6 +53,8 @@ def setting_label(setting: dict) -> str:
     parts = []
     for key, value in setting.items():
         text = f"{value:g}" if isinstance(value, float) else str(value)
+        if key == "case":   # a case file: its name says it
+            text = Path(text).name.removesuffix(".textproto")
         key = key.replace("set:", "").replace(".", "-")
         parts.append(f"{key}={text}".replace("/", "_").replace(" ", ""))
     return ",".join(parts) if parts else "default"

@@ -125,6 +125,54 @@ class FileCaseScene(unittest.TestCase):
             self.assertTrue(mesh.is_absolute() and mesh.is_file(), mesh)
 
 
+    def test_a_case_axis_is_labelled_by_the_file_name(self):
+        label = scenes.setting_label({"case": "../cases/fe-mhgo-sector-coarse.textproto",
+                                      "set:solid.element_family": "HEXAHEDRON"})
+        self.assertEqual(label, "case=fe-mhgo-sector-coarse,solid-element_family=HEXAHEDRON")
+
+    def test_the_fe_opening_preset_names_existing_cases_and_its_finest(self):
+        from sweep.presets import PRESETS
+        spec = PRESETS["fe-opening-3d"]
+        scripts = Path(__file__).resolve().parents[2] / "scripts"
+        labels = [r.label for r in plan.expand(spec)]
+        self.assertIn(plan.finest_label(spec), labels)
+        for run in plan.expand(spec):
+            self.assertTrue((scripts / run.setting["case"]).is_file(), run.setting["case"])
+
+
+class FieldPeaks(unittest.TestCase):
+    def write_fields(self, folder: Path, strain_snapshots):
+        # two unit right triangles (area 0.5 each) and one of area 2: 3 elements, total area 3
+        nodes = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [2, 0, 0], [2, 2, 0]], float)
+        triangles = np.array([[0, 1, 2], [1, 3, 2], [1, 3, 4]])
+        with h5py.File(folder / "solid_fields.h5", "w") as f:
+            f["mesh/nodes"] = nodes
+            f["mesh/triangles"] = triangles
+            for k, strain in enumerate(strain_snapshots):
+                g = f.create_group(f"snapshots/{k:06d}")
+                g.attrs["time"] = 0.01 * k
+                g["position"] = nodes
+                g["max_principal_log_strain"] = np.asarray(strain, float)
+                g["max_principal_stress"] = 1e6 * np.asarray(strain, float)
+
+    def test_robust_peak_ignores_a_small_hot_element_and_takes_the_largest_snapshot(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            # element 0 (1/6 of the area) is hot in the first snapshot; the 1 % peak of that
+            # snapshot is its value; the second snapshot has the large element at 0.3
+            self.write_fields(Path(tmp), [[0.9, 0.1, 0.2], [0.1, 0.1, 0.3]])
+            peaks = metrics.field_peaks(Path(tmp))
+            self.assertAlmostEqual(peaks["peak_strain"], 0.9)
+            self.assertAlmostEqual(peaks["peak_stress"], 0.9e6)
+            self.assertAlmostEqual(peaks["peak_strain_time"], 0.0)
+        from valve_scene.analysis import area_percentile
+        # at 50 % of the area the large element (2/3 of it) decides, not the hot small one
+        self.assertAlmostEqual(area_percentile([0.9, 0.1, 0.2], [0.5, 0.5, 2.0], 0.5), 0.2)
+
+    def test_no_snapshots_no_peaks(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            self.assertEqual(metrics.field_peaks(Path(tmp)), {})
+
+
 class OpeningEvents(unittest.TestCase):
     def test_linear_ramp(self):
         t = np.linspace(0, 0.12, 1201)

@@ -68,6 +68,15 @@ BACKGROUND_PRESSURE_2D = False
 # twice or three times) the leaflet force stays at 3 N/m and the edge below 0.6 m/s.
 FLUID_CFL_2D = 0.1
 COUPLING_WINDOW_FACTOR_2D = 2.0
+# Session 6: the coupled leaflets are twice as heavy as the tissue (2 x 1100 kg/m^3), so the
+# 13 us window has mu = 1 instead of 2, the 1D piston's neutral limit where serial explicit
+# coupling neither damps nor grows a leaflet's fastest mode. At mu = 2 the coarse 2D valve's
+# leaflet rang in a 10.7 kHz in-plane mode (1 m/s at every node, neighbours in antiphase) from
+# ~0.17 s until the solid's energy stop (0.258 s) or the coupler's runaway bound (0.275-0.30 s);
+# at mu = 1 the same restart closes at 0.28 s (diastole: docs/fsi-2d.md, "Session 6").
+# The leaflet's own inertia (rho_s t = 0.55 kg/m^2) stays ~5 % of the blood's added mass on it
+# (~rho_f L = 12 kg/m^2), so the kinematics hardly change; the FE-only cases keep the tissue's.
+FSI_LEAFLET_DENSITY_FACTOR_2D = 2.0
 # The coaptation tie (solid_fe, docs/solid_fe.md "Coaptation tie"): the touching tips are held
 # on the annulus plane until the tie pulls harder than this per metre of depth. A forward
 # gradient dp loads the 11.25 mm flap with dp L = 1.5 N/m per mmHg, and a flap held at both ends
@@ -461,8 +470,10 @@ def case_text_2d(spec: Case2D) -> str:
     solid = ("solid {\n"
              f"  mesh_file: \"meshes/{spec.mesh_name}\"\n"
              "  element_family: SHELL\n"
-             + law +
-             f"  density: {LEAFLET_DENSITY:g}\n"
+             + law
+             + (f"  # {FSI_LEAFLET_DENSITY_FACTOR_2D:g} x the tissue's {LEAFLET_DENSITY:g} kg/m^3: mu = 1 for the window (valve2d.py, docs/fsi-2d.md)\n"
+                if spec.kind == "FSI" else "") +
+             f"  density: {leaflet_density(spec.kind):g}\n"
              + strip_depth_line() + fe_only_settings +
              "  fixed_node_sets: \"attachment\"\n"
              "  monitor_node_sets: \"free_edge_midpoints\"\n"
@@ -476,13 +487,18 @@ def case_text_2d(spec: Case2D) -> str:
         parts += [fluid_block_2d(PARTICLE_SPACING_2D[spec.resolution], background=BACKGROUND_PRESSURE_2D),
                   "coupling {\n"
                   "  scheme: SERIAL_EXPLICIT\n"
-                  f"  # acoustic estimate mu = 2 rho c dt / (rho_s t) = {2 * BLOOD_DENSITY * c0 * coupling_window(c0) / (LEAFLET_DENSITY * ValveParameters().thickness):.2f} (the 1D piston's limit is 2);\n"
-                  f"  # {COUPLING_WINDOW_FACTOR_2D:g} x the mu = 1 window, the fluid sub-cycling at CFL {FLUID_CFL_2D:g}: stable where\n"
-                  "  # the mu = 1 window is not (docs/stability-map.md)\n"
+                  f"  # acoustic estimate mu = 2 rho c dt / (rho_s t) = {2 * BLOOD_DENSITY * c0 * coupling_window(c0) / (leaflet_density(spec.kind) * ValveParameters().thickness):.2f} (the 1D piston's limit is 2);\n"
+                  f"  # {COUPLING_WINDOW_FACTOR_2D:g} x the tissue's mu = 1 window, the fluid sub-cycling at CFL {FLUID_CFL_2D:g}; the leaflet\n"
+                  f"  # {FSI_LEAFLET_DENSITY_FACTOR_2D:g} x as heavy (docs/stability-map.md, docs/fsi-2d.md)\n"
                   f"  window_size: {coupling_window(c0):g}\n"
                   "  mapping: NEAREST_PROJECTION\n"
                   "}\n"]
     return "".join(parts)
+
+
+def leaflet_density(kind: str) -> float:
+    """The solid's density in a 2D case: the tissue's FE-only, FSI_LEAFLET_DENSITY_FACTOR_2D x it coupled."""
+    return LEAFLET_DENSITY * (FSI_LEAFLET_DENSITY_FACTOR_2D if kind == "FSI" else 1.0)
 
 
 def strip_depth_line() -> str:

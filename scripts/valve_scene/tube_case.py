@@ -12,7 +12,9 @@ Choices (docs/valve-scene.md, "Tube"):
   (x, y on the fluid lattice) with its centre at R <= r < R + skirt_layers * dp, from the ring
   up to the attachment line's height at the column's azimuth: exactly the lattice points of a
   scalloped cylinder wall skirt_layers particles thick (a kernel support, so the blood inside
-  and the blood in the sinus outside do not see each other through it).
+  and the blood in the sinus outside do not see each other through it). The columns are those
+  of the case's fill lattice: cubic columns on the sector's hex-prism lattice left 33 blood
+  particles inside the skirt and 294 inside-sinus pairs within a support (measured with fluid_sph).
 - The plates move with the flow (about 4 cm per cycle), so the tube extends beyond the
   outlet plate by the travel of all cycles; the inlet plate's travel fits in the upstream
   length.
@@ -33,6 +35,7 @@ SECTION_PROBE_FRACTIONS = (-0.6, -0.3, 0.3, 0.6)   # extra tap probes across a s
 SECTOR_SECTION_AZIMUTHS_DEG = (10.0, 25.0, 35.0, 50.0)   # the sector's extra tap probes (inside its wedge)
 SKIRT_LAYERS = 3                      # skirt thickness in particle spacings: ceil(2h / dp) at h = 1.3 dp
 SECTOR_SKIRT_MARGIN = math.radians(15.0)  # skirt columns kept beyond the sector's mirror planes
+SECTOR_FILL_LATTICE = "HEX_PRISM"     # the sector's fluid lattice (the full valve keeps CUBIC: no mirror planes)
 
 
 def _vec(values) -> str:
@@ -58,35 +61,52 @@ def sector_mirror_planes() -> list[tuple[list[float], list[float]]]:
             ([0.0, 0.0, 0.0], [math.sin(a), -math.cos(a), 0.0])]
 
 
-def skirt_columns(particle_spacing: float, lattice_origin_xy: tuple[float, float] = (0.0, 0.0),
-                  valve: ValveParameters | None = None, sector: bool = False,
-                  layers: int = SKIRT_LAYERS) -> list[tuple[float, float, float]]:
+def lattice_columns(particle_spacing: float, half_extent: float, lattice: str = "CUBIC") -> list[tuple[float, float]]:
+    """The (x, y) of the fluid lattice's columns along z within |x|, |y| <= half_extent, for
+    lattice_origin x, y = 0: CUBIC ((i + 1/2) dp, (j + 1/2) dp), or HEX_PRISM with axis z and rows
+    along x (fluid_sph's fill, docs/fluid_sph.md "Fill lattice": side a = dp (2/sqrt 3)^1/2, rows
+    h = a sqrt(3)/2 apart; x = a/4 + a i + a j/2, y = (j - 1/2) h, the same in every layer)."""
+    dp = particle_spacing
+    if lattice == "CUBIC":
+        n = int(math.ceil(half_extent / dp)) + 1
+        return [((i + 0.5) * dp, (j + 0.5) * dp) for i in range(-n, n) for j in range(-n, n)]
+    if lattice != "HEX_PRISM":
+        raise ValueError(f"fill lattice '{lattice}': allowed CUBIC or HEX_PRISM")
+    a = dp * math.sqrt(2.0 / math.sqrt(3.0))
+    h = 0.5 * math.sqrt(3.0) * a
+    nj = int(math.ceil(half_extent / h)) + 2
+    columns = []
+    for j in range(-nj, nj + 1):
+        start = 0.25 * a + 0.5 * a * j
+        ni = int(math.ceil((half_extent + abs(start)) / a)) + 1
+        columns += [(start + a * i, (j - 0.5) * h) for i in range(-ni, ni + 1)]
+    return [(x, y) for x, y in columns if abs(x) <= half_extent and abs(y) <= half_extent]
+
+
+def skirt_columns(particle_spacing: float, valve: ValveParameters | None = None, sector: bool = False,
+                  layers: int = SKIRT_LAYERS, lattice: str = "CUBIC") -> list[tuple[float, float, float]]:
     """The scalloped skirt above the annulus plane as lattice columns (x, y, top z): every
-    fluid-lattice column whose centre lies at R <= r < R + layers * dp, topped at the skirt's
-    top edge (tube.skirt_top_height: the attachment line, the commissure-tab top between tabs)
-    over the column's footprint (its azimuth +- dp / 2r). A sector keeps the columns within its wedge plus a margin."""
+    fluid-lattice column (CUBIC or HEX_PRISM, lattice_columns) whose centre lies at
+    R <= r < R + layers * dp, topped at the skirt's top edge (tube.skirt_top_height: the
+    attachment line, the commissure-tab top between tabs) over the column's footprint (its
+    azimuth +- dp / 2r). A sector keeps the columns within its wedge plus a margin."""
     from .tube import skirt_top_height
     valve = valve or ValveParameters()
     dp = particle_spacing
     R = valve.annulus_radius
     outer = R + layers * dp
-    n = int(math.ceil(outer / dp)) + 2
-    ox, oy = lattice_origin_xy
     columns = []
-    for i in range(-n, n + 1):
-        x = ox + (i + 0.5) * dp
-        for j in range(-n, n + 1):
-            y = oy + (j + 0.5) * dp
-            r = math.hypot(x, y)
-            if not R <= r < outer:
-                continue
-            azimuth = math.atan2(y, x)
-            if sector and not -SECTOR_SKIRT_MARGIN <= azimuth <= SECTOR_HALF_ANGLE + SECTOR_SKIRT_MARGIN:
-                continue
-            # the highest top over the column's footprint, so the narrow gap between two
-            # commissure tabs (0.5 mm, under a particle) is closed to the tab tops
-            footprint = np.linspace(azimuth - 0.5 * dp / r, azimuth + 0.5 * dp / r, 9)
-            columns.append((x, y, float(np.max(skirt_top_height(footprint, valve)))))
+    for x, y in lattice_columns(dp, outer + dp, lattice):
+        r = math.hypot(x, y)
+        if not R <= r < outer:
+            continue
+        azimuth = math.atan2(y, x)
+        if sector and not -SECTOR_SKIRT_MARGIN <= azimuth <= SECTOR_HALF_ANGLE + SECTOR_SKIRT_MARGIN:
+            continue
+        # the highest top over the column's footprint, so the narrow gap between two
+        # commissure tabs (0.5 mm, under a particle) is closed to the tab tops
+        footprint = np.linspace(azimuth - 0.5 * dp / r, azimuth + 0.5 * dp / r, 9)
+        columns.append((x, y, float(np.max(skirt_top_height(footprint, valve)))))
     return columns
 
 
@@ -114,6 +134,7 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
     tube_end = z_outlet + plate + travel + 2 * dp
     ring_start = setup.gasket_z - setup.gasket_thickness
     margin = 6 * dp
+    lattice = SECTOR_FILL_LATTICE if sector else "CUBIC"
     half_column = 0.45 * dp   # a column box holds exactly its lattice column's points
     # flow sections stay ahead of the inlet plate over all cycles (it travels ~5 cm per cycle)
     probes_z = {"upstream_tap": -setup.upstream_tap_distance,
@@ -133,6 +154,10 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
         f"  domain_lower: {_vec([-margin if sector else -R_tube - margin, -margin if sector else -R_tube - margin, tube_start - margin])}",
         f"  domain_upper: {_vec([R_tube + margin, R_tube + margin, tube_end + margin])}",
         f"  lattice_origin: {_vec([0.0, 0.0, z_inlet])}",
+        *(["  # hex-prism fill: triangular layers along the axis, rows along both mirror planes (docs/fluid_sph.md)",
+           "  fill_lattice: HEX_PRISM",
+           "  lattice_axis: [0, 0, 1]",
+           "  lattice_row_direction: [1, 0, 0]"] if lattice == "HEX_PRISM" else []),
         *([f"  # 1/6 sector: the bisecting plane (on a lattice plane) and the coaptation plane as mirrors"] +
           [f"  mirror_planes {{ point: {_vec(point)} normal: [{', '.join(f'{v:.15g}' for v in normal)}] }}"
            for point, normal in sector_mirror_planes()]
@@ -149,7 +174,7 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
         "  # one solid box per fluid-lattice column (no primitive follows a scallop; tube_case.py)",
         *[f"  walls {{ solid_box {{ lower: {_vec([x - half_column, y - half_column, ring_start])} "
           f"upper: {_vec([x + half_column, y + half_column, top])} }} }}"
-          for x, y, top in skirt_columns(dp, (0.0, 0.0), valve, sector)],
+          for x, y, top in skirt_columns(dp, valve, sector, lattice=lattice)],
         "  # inlet plate: left-ventricular pressure",
         "  plates {",
         f"    shape {{ annular_disk {{ origin: {_vec([0, 0, z_inlet - plate])} axis: [0, 0, 1] thickness: {plate:.6g} outer_radius: {R_tube:.6g} }} }}",

@@ -62,6 +62,17 @@ TEST(SceneCaseFiles, LoadAndMatchTheirNames) {
       // a sector's wedge between two mirror planes, its plates a sixth of the tube
       EXPECT_EQ(c.fluid().mirror_planes_size(), m[3] == "sector" ? 2 : 0);
       EXPECT_NEAR(c.fluid().plates(0).area(), M_PI * 0.0184 * 0.0184 / (m[3] == "sector" ? 6.0 : 1.0), 1e-8);
+      // the sector fills on the hex-prism lattice whose rows run along both mirror planes (no empty
+      // slab along the coaptation plane); the full valve has no planes and keeps the cubic lattice
+      if (m[3] == "sector") {
+        EXPECT_EQ(c.fluid().fill_lattice(), valvefsi::cases::FluidCase::HEX_PRISM);
+        ASSERT_EQ(c.fluid().lattice_axis_size(), 3);
+        EXPECT_EQ(c.fluid().lattice_axis(2), 1.0);
+        ASSERT_EQ(c.fluid().lattice_row_direction_size(), 3);
+        EXPECT_EQ(c.fluid().lattice_row_direction(0), 1.0);
+      } else {
+        EXPECT_EQ(c.fluid().fill_lattice(), valvefsi::cases::FluidCase::CUBIC);
+      }
     }
   }
 }

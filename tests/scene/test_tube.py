@@ -103,9 +103,18 @@ class StentRing(unittest.TestCase):
         self.assertAlmostEqual(inner, R, delta=1e-12)
         self.assertAlmostEqual(outer, R_tube, delta=1e-9)                # seals the tube upstream
         boxes = np.array(boxes)
-        # the fluid's lattice (lattice_origin x, y = 0) near the stent, z from the ring to above the tabs
-        grid = (np.arange(-16, 16) + 0.5) * dp
-        x, y = np.meshgrid(grid, grid, indexing="ij")
+        # the fluid's lattice (lattice_origin x, y = 0) near the stent, z from the ring to above the tabs:
+        # cubic for the full valve, hex prism for the sector (docs/fluid_sph.md "Fill lattice":
+        # x = a/4 + a i + a j/2, y = (j - 1/2) h, a = dp (2/sqrt 3)^1/2, h = a sqrt(3)/2)
+        if sector:
+            a = dp * math.sqrt(2 / math.sqrt(3))
+            h = a * math.sqrt(3) / 2
+            i, j = np.meshgrid(np.arange(-30, 31), np.arange(-20, 21), indexing="ij")
+            x, y = 0.25 * a + a * i + 0.5 * a * j, (j - 0.5) * h
+            x, y = x[np.abs(x) < 16 * dp], y[np.abs(x) < 16 * dp]
+        else:
+            grid = (np.arange(-16, 16) + 0.5) * dp
+            x, y = np.meshgrid(grid, grid, indexing="ij")
         r, azimuth = np.hypot(x, y), np.arctan2(y, x)
         z_levels = z0 + (np.arange(0, int((14e-3 - z0) / dp)) + 0.5) * dp
         wedge = (azimuth >= 0) & (azimuth <= SECTOR_HALF_ANGLE) if sector else np.ones_like(r, bool)

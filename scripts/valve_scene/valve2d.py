@@ -77,6 +77,12 @@ COUPLING_WINDOW_FACTOR_2D = 2.0
 # The leaflet's own inertia (rho_s t = 0.55 kg/m^2) stays ~5 % of the blood's added mass on it
 # (~rho_f L = 12 kg/m^2), so the kinematics hardly change; the FE-only cases keep the tissue's.
 FSI_LEAFLET_DENSITY_FACTOR_2D = 2.0
+# Closed, the heavier leaflets' tips chatter on the annulus plane under the diastolic load (the
+# pressed-flap instability of docs/solid_fe.md, which mass damping of 200 /s cures there): from the
+# same restart the undamped valve runs away at 0.358 s (tip at 20.6 m/s), the damped one holds
+# its tips within 0.7 mm of the axis past the -97 mmHg peak (docs/fsi-2d.md, "Session 6"). The
+# damping's force, 200 /s x 0.55 kg/m^2 = 110 Pa per m/s, is below 1 mmHg at the leaflets' speeds.
+FSI_MASS_DAMPING_PER_S_2D = 200.0
 # The coaptation tie (solid_fe, docs/solid_fe.md "Coaptation tie"): the touching tips are held
 # on the annulus plane until the tie pulls harder than this per metre of depth. A forward
 # gradient dp loads the 11.25 mm flap with dp L = 1.5 N/m per mmHg, and a flap held at both ends
@@ -463,6 +469,8 @@ def case_text_2d(spec: Case2D) -> str:
         law = "  material: OGDEN\n  ogden { " + " ".join(f"{k}: {v:g}" for k, v in OGDEN.items()) + " }\n"
     else:
         law = "  material: MHGO\n  mhgo { " + " ".join(f"{k}: {v:g}" for k, v in MHGO.items()) + " }\n"
+    fsi_settings = ("  # damps the closed tips' chatter on the annulus plane (valve2d.py, docs/fsi-2d.md)\n"
+                    f"  mass_damping_per_s: {FSI_MASS_DAMPING_PER_S_2D:g}\n") if spec.kind == "FSI" else ""
     fe_only_settings = ("  # FE-only 2D: damping stands in for the missing fluid (undamped, the strips flap at ~5 m/s\n"
                         "  # and break the run within 0.1 s); a third of the estimated step survives the stent contact\n"
                         f"  mass_damping_per_s: {FE_ONLY_DAMPING_PER_S:g}\n"
@@ -474,7 +482,7 @@ def case_text_2d(spec: Case2D) -> str:
              + (f"  # {FSI_LEAFLET_DENSITY_FACTOR_2D:g} x the tissue's {LEAFLET_DENSITY:g} kg/m^3: mu = 1 for the window (valve2d.py, docs/fsi-2d.md)\n"
                 if spec.kind == "FSI" else "") +
              f"  density: {leaflet_density(spec.kind):g}\n"
-             + strip_depth_line() + fe_only_settings +
+             + strip_depth_line() + fe_only_settings + fsi_settings +
              "  fixed_node_sets: \"attachment\"\n"
              "  monitor_node_sets: \"free_edge_midpoints\"\n"
              + (f"  # the coapted tips stay on the annulus plane until pulled by {COAPTATION_TIE_RELEASE_N_PER_M:g} N/m (valve2d.py)\n"

@@ -4,7 +4,7 @@ leaflet area by stress lies, how far leaflets fold past their coaptation planes,
 membrane fibre strain that the MHGO exponential turns into stress.
 
     cd scripts && /usr/bin/python3 -m valve_scene.closed_state FULL_RUN SECTOR_RUN --time 0.15 \\
-        --full-mesh ../cases/meshes/valve-full-coarse.mesh.h5 --sector-mesh ../cases/meshes/valve-sector-coarse.mesh.h5 [--png X.png]
+        --full-mesh ../cases/meshes/valve-full-coarse.mesh.h5 --sector-mesh ../cases/meshes/valve-sector-coarse.mesh.h5 [--png ../docs/figures/closed-full-vs-sector.png]
 """
 from __future__ import annotations
 
@@ -77,6 +77,23 @@ def top_area_elements(values: np.ndarray, areas: np.ndarray, fraction: float = T
     return order[:int(np.searchsorted(covered, fraction * areas.sum())) + 1]
 
 
+def neighbour_stress_ratio(stress: np.ndarray, triangles: np.ndarray, floor_Pa: float = 1e3) -> float:
+    """Median ratio of the stresses of two triangles sharing an edge (>= 1): ~1 for a smooth
+    field, large when the field is speckled element by element (vibration at the mesh scale)."""
+    first = {}
+    pairs = []
+    for e, t in enumerate(triangles):
+        for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+            key = (min(a, b), max(a, b))
+            if key in first:
+                pairs.append((first[key], e))
+            else:
+                first[key] = e
+    pairs = np.array(pairs)
+    s = np.maximum(stress, floor_Pa)
+    return float(np.exp(np.median(np.abs(np.log(s[pairs[:, 0]] / s[pairs[:, 1]])))))
+
+
 def closed_state(run_dir: Path, mesh_file: Path, time: float, fibre_angle_deg: float, full: bool) -> dict:
     fields = SolidFields(run_dir)
     snap = fields.snapshot(fields.nearest(time))
@@ -91,6 +108,12 @@ def closed_state(run_dir: Path, mesh_file: Path, time: float, fibre_angle_deg: f
     beyond = -(mapped @ coaptation_normal())   # > 0: past the coaptation plane, into the neighbour's half
     fibre = membrane_fibre_log_strain(ref, snap["position"], tri, c, r, fibre_angle_deg)
     top = top_area_elements(stress, areas)
+    with h5py.File(fields.path, "r") as f:
+        velocity = f["snapshots"][fields.names[fields.nearest(time)]]["velocity"][()]
+    with h5py.File(Path(run_dir) / "solid_series.h5", "r") as f:
+        i = int(np.argmin(np.abs(f["time"][()] - time)))
+        scale = 1.0 if full else 2.0 * LEAFLET_COUNT   # the sector's energies are a sixth of the valve's
+        energies = {k: float(f[f"energy/{k}"][i]) * scale for k in ("kinetic", "strain_energy", "external_work")}
     centroids = (to_sector_frame(ref, ref)[0] if full else ref)[tri].mean(axis=1)
     return {"time": float(fields.times[fields.nearest(time)]),
             "stress_p99_MPa": area_percentile(stress, areas) / 1e6,
@@ -99,8 +122,56 @@ def closed_state(run_dir: Path, mesh_file: Path, time: float, fibre_angle_deg: f
             "fibre_strain_p99": area_percentile(fibre, areas),
             "nodes_past_plane": int(np.sum(beyond > 0.0)),
             "largest_past_plane_mm": float(max(beyond.max(), 0.0)) * 1e3,
+            "kinetic_mJ": energies["kinetic"] * 1e3, "strain_energy_mJ": energies["strain_energy"] * 1e3,
+            "external_work_mJ": energies["external_work"] * 1e3,
+            "node_speed_rms": float(np.sqrt(np.mean(np.sum(velocity ** 2, axis=1)))),
+            "neighbour_stress_ratio": neighbour_stress_ratio(stress, tri),
             "top_azimuth_deg": np.degrees(np.arctan2(centroids[top, 1], centroids[top, 0])),
             "top_z_mm": centroids[top, 2] * 1e3}
+
+
+def _sector_copies(points: np.ndarray) -> list[np.ndarray]:
+    """The sector's six images making the full valve: three turns, each with its mirror in y = 0."""
+    copies = []
+    for k in range(LEAFLET_COUNT):
+        a = k * 2.0 * math.pi / LEAFLET_COUNT
+        for mirror in (1.0, -1.0):
+            x, y = points[..., 0], mirror * points[..., 1]
+            copies.append(np.stack([x * math.cos(a) - y * math.sin(a), x * math.sin(a) + y * math.cos(a)], axis=-1))
+    return copies
+
+
+def plot_top_views(full_run: Path, sector_run: Path, time: float, path: Path) -> None:
+    """Top views (seen from the aorta) of the two closed valves coloured by element stress, the
+    elements of the top 1 % of the area outlined."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PolyCollection
+    from matplotlib.colors import LogNorm
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5.2))
+    norm = LogNorm(vmin=0.05, vmax=50.0)
+    for ax, run, full in ((axes[0], full_run, True), (axes[1], sector_run, False)):
+        fields = SolidFields(run)
+        snap = fields.snapshot(fields.nearest(time))
+        tri, stress = fields.triangles, snap["max_principal_stress"] / 1e6
+        areas = triangle_areas(fields.reference_nodes, tri)
+        top = top_area_elements(stress, areas)
+        polys = [snap["position"][tri][:, :, :2]] if full else _sector_copies(snap["position"][tri])
+        for copy in polys:
+            ax.add_collection(PolyCollection(copy * 1e3, array=np.clip(stress, 0.05, None), cmap="viridis", norm=norm,
+                                             edgecolors="none"))
+            ax.add_collection(PolyCollection(copy[top] * 1e3, facecolors="none", edgecolors="r", linewidths=0.8))
+        ax.set_xlim(-12.5, 12.5)
+        ax.set_ylim(-12.5, 12.5)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (mm)")
+        ax.set_title(f"{'full valve' if full else 'sector x 6'}, t = {fields.times[fields.nearest(time)]:.3f} s of the run: "
+                     f"p99 {area_percentile(stress, areas):.1f} MPa", fontsize=9)
+    axes[0].set_ylabel("y (mm)")
+    fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap="viridis"), ax=axes, label="max principal stress (MPa); red: top 1 % of area")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 def main(argv=None) -> None:
@@ -111,14 +182,20 @@ def main(argv=None) -> None:
     parser.add_argument("--full-mesh", type=Path, required=True)
     parser.add_argument("--sector-mesh", type=Path, required=True)
     parser.add_argument("--fibre-angle-deg", type=float, default=43.11)
+    parser.add_argument("--png", type=Path, help="top views of the two closed valves at the last --time")
     args = parser.parse_args(argv)
-    print("| run | t (s) | stress p99 (MPa) | median | log strain p99 | membrane fibre strain p99 | nodes past the plane | largest (mm) | top-1 % area: azimuth (deg), z (mm) |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    if args.png:
+        plot_top_views(args.full_run, args.sector_run, args.time[-1], args.png)
+    print("| run | t (s) | stress p99 (MPa) | median | log strain p99 | membrane fibre strain p99 | nodes past the plane | largest (mm) | "
+          "kinetic / strain energy / external work (mJ, valve) | node speed rms (m/s) | neighbour stress ratio | top-1 % area: azimuth (deg), z (mm) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for t in args.time:
         for name, run, mesh, full in (("full", args.full_run, args.full_mesh, True), ("sector", args.sector_run, args.sector_mesh, False)):
             s = closed_state(run, mesh, t, args.fibre_angle_deg, full)
             print(f"| {name} | {s['time']:.3f} | {s['stress_p99_MPa']:.2f} | {s['stress_median_MPa']:.2f} | {s['strain_p99']:.3f} | "
                   f"{s['fibre_strain_p99']:.4f} | {s['nodes_past_plane']} | {s['largest_past_plane_mm']:.2f} | "
+                  f"{s['kinetic_mJ']:.2f} / {s['strain_energy_mJ']:.2f} / {s['external_work_mJ']:.2f} | {s['node_speed_rms']:.2f} | "
+                  f"{s['neighbour_stress_ratio']:.2f} | "
                   f"{np.median(s['top_azimuth_deg']):.0f} ({s['top_azimuth_deg'].min():.0f}-{s['top_azimuth_deg'].max():.0f}), "
                   f"{np.median(s['top_z_mm']):.1f} ({s['top_z_mm'].min():.1f}-{s['top_z_mm'].max():.1f}) |")
 

@@ -5,7 +5,7 @@ import unittest
 import numpy as np
 
 from valve_scene.closed_state import (coaptation_normal, membrane_fibre_log_strain, mhgo_fibre_stress,
-                                      to_sector_frame, top_area_elements)
+                                      neighbour_stress_ratio, to_sector_frame, top_area_elements)
 
 
 class SectorFrame(unittest.TestCase):
@@ -65,6 +65,19 @@ class TopArea(unittest.TestCase):
         self.assertEqual(sorted(top.tolist()), [396, 397, 398, 399])   # the 4 largest cover exactly 1 %
         areas[399] = 10.0                                                   # one element larger than 1 % of the area
         self.assertEqual(top_area_elements(values, areas).tolist(), [399])
+
+
+class Speckle(unittest.TestCase):
+    def test_smooth_and_checkerboard_fields(self):
+        # a strip of 2 x 10 squares, each split in two triangles: 20 triangles, 29 shared edges
+        triangles = []
+        for i in range(10):
+            a, b, c, d = i, i + 1, 11 + i, 12 + i
+            triangles += [[a, b, d], [a, d, c]]
+        triangles = np.array(triangles)
+        self.assertAlmostEqual(neighbour_stress_ratio(np.full(20, 2e5), triangles), 1.0, delta=1e-12)
+        checker = np.where(np.arange(20) % 2 == 0, 1e5, 4e5)   # every shared edge joins a low and a high one
+        self.assertAlmostEqual(neighbour_stress_ratio(checker, triangles), 4.0, delta=1e-12)
 
 
 if __name__ == "__main__":

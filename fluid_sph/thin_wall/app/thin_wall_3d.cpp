@@ -66,7 +66,7 @@ void write_particle_dump(const std::string& file, const FluidSolver<3>& solver, 
 // rest in it, for a number of steps: loads at rest, leaks and the cost per step, with and
 // without the surface.
 int run_case_at_rest(const std::string& case_file, const std::string& surface_file, long steps, bool no_surface, bool aligned, bool behind_only,
-                     int relax_cycles, long relax_steps) {
+                     int relax_cycles, long relax_steps, double smoothing_ratio) {
   const valvefsi::cases::Case c = valvefsi::load_case(case_file);
   auto setup = fluid_setup_from_case<3>(c, case_file);
   FluidSolver<3> solver = make_solver<3>(std::move(setup));
@@ -76,6 +76,8 @@ int run_case_at_rest(const std::string& case_file, const std::string& surface_fi
     settings.wall_acceleration_in_pressure = c.fluid().thin_walls().wall_acceleration_in_pressure();
     settings.particle_aligned_layers = aligned;
     settings.lattice_in_front = !behind_only;
+    settings.load_smoothing_radius_ratio =
+        smoothing_ratio >= 0 ? smoothing_ratio : c.fluid().thin_walls().load_smoothing_radius_ratio();
     FluidSettings<3> fluid = solver.settings();
     if (std::getenv("THIN_WALL_NO_IMAGES")) fluid.mirror_planes.clear();  // diagnostics: the leaflet without its images
     auto m = std::make_unique<ThinWallModel3D>(read_surface(surface_file), fluid, settings);
@@ -186,21 +188,27 @@ int run_case_at_rest(const std::string& case_file, const std::string& surface_fi
         if (p.kind[i] == Kind::fluid)
           v2 = std::max(v2, static_cast<double>(p.velocity[0][i] * p.velocity[0][i] + p.velocity[1][i] * p.velocity[1][i] +
                                                 p.velocity[2][i] * p.velocity[2][i]));
-      double load = 0, area = 0;
+      double load = 0, area = 0, largest = 0, largest_raw = 0, raw_load = 0;
       Vec3 f{0, 0, 0};
       if (model) {
         std::vector<Vec<3>> forces(model->node_count());
         model->node_forces(forces);
+        const auto& raw = model->raw_node_forces();
         for (std::size_t j = 0; j < forces.size(); ++j) {
-          load += std::sqrt(forces[j][0] * forces[j][0] + forces[j][1] * forces[j][1] + forces[j][2] * forces[j][2]);
+          const double fj = std::sqrt(forces[j][0] * forces[j][0] + forces[j][1] * forces[j][1] + forces[j][2] * forces[j][2]);
+          const double rj = j < raw.size() ? std::sqrt(raw[j][0] * raw[j][0] + raw[j][1] * raw[j][1] + raw[j][2] * raw[j][2]) : 0.0;
+          load += fj;
+          raw_load += rj;
+          largest = std::max(largest, fj / model->node_areas()[j]);
+          largest_raw = std::max(largest_raw, rj / model->node_areas()[j]);
           area += model->node_areas()[j];
           for (int d = 0; d < 3; ++d) f[d] += forces[j][d];
         }
       }
-      std::printf("step %ld t %.4e s: net force %.4g %.4g %.4g N, mean node load %.4g Pa, net/area %.4g Pa, max speed %.4g m/s, "
-                  "leaks %zu\n",
-                  k + 1, solver.time(), f[0], f[1], f[2], area > 0 ? load / area : 0.0,
-                  area > 0 ? std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) / area : 0.0, std::sqrt(v2),
+      std::printf("step %ld t %.4e s: net force %.4g %.4g %.4g N, mean node load %.4g Pa (raw %.4g), largest %.4g Pa (raw %.4g), "
+                  "net/area %.4g Pa, max speed %.4g m/s, leaks %zu\n",
+                  k + 1, solver.time(), f[0], f[1], f[2], area > 0 ? load / area : 0.0, area > 0 ? raw_load / area : 0.0, largest,
+                  largest_raw, area > 0 ? std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) / area : 0.0, std::sqrt(v2),
                   model ? model->counters().leaks : std::size_t{0});
       std::fflush(stdout);
     }
@@ -228,13 +236,14 @@ int run_case_at_rest(const std::string& case_file, const std::string& surface_fi
                 mean_pressure / area, area);
     if (const char* dump = std::getenv("THIN_WALL_NODE_DUMP")) {
       std::ofstream out(dump);
-      out << "x,y,z,fx,fy,fz,area,p0,p1,w0,w1\n";
+      out << "x,y,z,fx,fy,fz,area,p0,p1,w0,w1,fx_raw,fy_raw,fz_raw\n";
       const auto& m = model->mesh();
       for (std::size_t j = 0; j < forces.size(); ++j) {
         const auto& st = model->node_states()[j];
         out << m.position[j][0] << ',' << m.position[j][1] << ',' << m.position[j][2] << ',' << forces[j][0] << ','
             << forces[j][1] << ',' << forces[j][2] << ',' << model->node_areas()[j] << ',' << st.side[0].pressure << ','
-            << st.side[1].pressure << ',' << st.side[0].weight << ',' << st.side[1].weight << '\n';
+            << st.side[1].pressure << ',' << st.side[0].weight << ',' << st.side[1].weight << ',' << model->raw_node_forces()[j][0]
+            << ',' << model->raw_node_forces()[j][1] << ',' << model->raw_node_forces()[j][2] << '\n';
       }
     }
     std::printf("surface: %zu particles near it; total force %.4g %.4g %.4g N, largest node force %.3g N; corrections %zu leaks %zu "
@@ -276,12 +285,15 @@ int main(int argc, char** argv) {
   bool aligned = false, behind_only = false;
   int relax_cycles = 0;
   long relax_steps = 20;
+  double smoothing_ratio = -1.0;
   app.add_option("--relax-cycles", relax_cycles, "with --case: start-up relaxation cycles (velocities and densities reset after each)");
   app.add_option("--relax-steps", relax_steps, "with --case: steps per relaxation cycle");
   app.add_flag("--behind-only", behind_only, "virtual lattice behind the tangent plane only");
+  app.add_option("--load-smoothing", smoothing_ratio, "with --case: node-load smoothing radius / dp (default: the case's)");
   app.add_flag("--aligned-layers", aligned, "virtual layers continue the particle's own lattice through the wall");
   CLI11_PARSE(app, argc, argv);
-  if (!case_file.empty()) return run_case_at_rest(case_file, surface_file, steps, no_surface, aligned, behind_only, relax_cycles, relax_steps);
+  if (!case_file.empty()) return run_case_at_rest(case_file, surface_file, steps, no_surface, aligned, behind_only, relax_cycles, relax_steps,
+                                                   smoothing_ratio);
 
   ThinWallCase3D c = scene == "two_levels" ? two_level_tank_3d(dp, 0.5, 0.25, width, 0.0, mirror)
                      : scene == "gap"      ? two_level_tank_3d(dp, 0.5, 0.25, width, gap, mirror)

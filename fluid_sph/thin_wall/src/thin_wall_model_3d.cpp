@@ -166,6 +166,8 @@ ThinWallModel3D::ThinWallModel3D(const ImmersedSurfaceGeometry<3>& g, const Flui
     for (const std::uint32_t n : tri) area_[n] += a / 3.0;
   }
   clearance_ = std::max(settings_.clearance_ratio * dp, 0.5 * thickest);
+  if (settings_.load_smoothing_radius_ratio > 0.0)
+    smoother_ = NodeLoadSmoother(g.nodes, triangles, area_, settings_.load_smoothing_radius_ratio * dp);
 
   // The mesh with its mirror images, under each plane's reflection and, where the planes cross
   // (a sector's axis), every other element of the group they generate, as the fluid makes its
@@ -711,7 +713,11 @@ bool ThinWallModel3D::accept_shift(const Particles<3>& p, std::size_t i, const V
 void ThinWallModel3D::node_forces(std::span<Vec<3>> forces) const {
   if (forces.size() != node_count_)
     throw std::invalid_argument(fmt::format("thin wall node_forces: {} entries given: needs one per node ({})", forces.size(), node_count_));
-  for (std::size_t j = 0; j < node_count_; ++j) forces[j] = j < dyn_.force.size() ? dyn_.force[j] : Vec3{0, 0, 0};
+  if (dyn_.force.size() != node_count_) {
+    std::fill(forces.begin(), forces.end(), Vec<3>{0, 0, 0});
+    return;
+  }
+  smoother_.apply(dyn_.x, dyn_.force, forces);
 }
 
 Vec3 ThinWallModel3D::total_force() const {
@@ -839,6 +845,7 @@ std::unique_ptr<ImmersedSurfaceModel<3>> make_thin_wall_model_3d(const ImmersedS
   if (spacing_given) settings.virtual_spacing_ratio = checked.virtual_spacing_ratio();
   settings.clearance_ratio = checked.clearance_ratio();
   settings.wall_acceleration_in_pressure = checked.wall_acceleration_in_pressure();
+  settings.load_smoothing_radius_ratio = checked.load_smoothing_radius_ratio();
   return std::make_unique<ThinWallModel3D>(geometry, fluid, settings);
 }
 

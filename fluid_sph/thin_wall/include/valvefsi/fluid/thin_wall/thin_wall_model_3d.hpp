@@ -30,6 +30,7 @@
 #include "valvefsi/fluid/fluid_settings.hpp"
 #include "valvefsi/fluid/immersed_surface.hpp"
 #include "valvefsi/fluid/mirror_group.hpp"
+#include "valvefsi/fluid/thin_wall/load_smoothing.hpp"
 #include "valvefsi/fluid/thin_wall/triangle_mesh.hpp"
 #include "valvefsi/fluid/thin_wall/window_motion.hpp"
 
@@ -54,6 +55,9 @@ struct ThinWall3DSettings {
   bool lattice_in_front = false;
   // Extrapolate the wall pressure with the wall's acceleration (eq. 27); off in coupled runs.
   bool wall_acceleration_in_pressure = true;
+  // Radius (over dp, along the mesh) over which each node's load is spread before it goes to
+  // the solid, conserving total force and moment (load_smoothing.hpp); 0: the raw loads.
+  double load_smoothing_radius_ratio = 0.0;
 };
 
 // Consistent orientation of an open triangle mesh: flips triangles (per connected piece, from
@@ -107,6 +111,9 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
   const std::vector<NodeState>& node_states() const { return dyn_.state; }
   const std::vector<double>& node_areas() const { return area_; }
   Vec3 total_force() const;  // sum of the node forces
+  // The loads as the fluid's virtual points left them on the nodes (node_forces: smoothed).
+  const std::vector<Vec3>& raw_node_forces() const { return dyn_.force; }
+  const NodeLoadSmoother& load_smoother() const { return smoother_; }
   std::size_t near_count() const;
   double time() const { return dyn_.motion.current_time(); }
 
@@ -158,6 +165,7 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
   std::vector<double> face_offset_;  // normal . first corner
   std::vector<std::array<Vec3, 2>> face_box_;  // bounding box per mesh triangle
   TriangleBuckets buckets_;
+  NodeLoadSmoother smoother_;
   Dynamic dyn_;
   std::optional<Dynamic> checkpoint_;
 };

@@ -13,7 +13,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <fstream>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "test_helpers.hpp"
@@ -98,6 +101,12 @@ inline DamBreakFrontResult compare_dam_break_front(double dp) {
     spdlog::info("dam break dp = {} m: T = {:.3f}  Z measured {:.3f}  SPH {:.3f} ({:+.1f} %), at T - {:.3f}: {:.3f} ({:+.1f} %)",
                  dp, measured[k].first, measured[k].second, front_at(measured[k].first), 100 * plain[k], result.shift,
                  front_at(measured[k].first - result.shift), 100 * shifted[k]);
+  // The samples for the docs' figure (fluid_sph/scripts/plot_dam_break_front.py), when asked.
+  if (const char* dir = std::getenv("VALVEFSI_DAM_BREAK_FRONT_DIR")) {
+    std::ofstream out(std::string(dir) + "/dam_break_front_dp" + std::to_string(dp) + ".csv");
+    out << "# dam break front, dp = " << dp << " m, fitted delay " << result.shift << "\nT,Z\n";
+    for (std::size_t k = 0; k < sample_T.size(); ++k) out << sample_T[k] << "," << sample_Z[k] << "\n";
+  }
   result.worst_unshifted = worst(plain);
   result.worst_shifted = worst(shifted);
   result.crossed_wall = crossed.size();

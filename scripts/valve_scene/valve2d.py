@@ -83,6 +83,7 @@ FSI_LEAFLET_DENSITY_FACTOR_2D = 2.0
 # its tips within 0.7 mm of the axis past the -97 mmHg peak (docs/fsi-2d.md, "Session 6"). The
 # damping's force, 200 /s x 0.55 kg/m^2 = 110 Pa per m/s, is below 1 mmHg at the leaflets' speeds.
 FSI_MASS_DAMPING_PER_S_2D = 200.0
+RESTART_INTERVAL_2D_S = 0.2
 # The coaptation tie (solid_fe, docs/solid_fe.md "Coaptation tie"): the touching tips are held
 # on the annulus plane until the tie pulls harder than this per metre of depth. A forward
 # gradient dp loads the 11.25 mm flap with dp L = 1.5 N/m per mmHg, and a flap held at both ends
@@ -494,6 +495,8 @@ def case_text_2d(spec: Case2D) -> str:
         c0 = sound_speed_2d()
         parts += [fluid_block_2d(PARTICLE_SPACING_2D[spec.resolution], background=BACKGROUND_PRESSURE_2D),
                   "coupling {\n"
+                  f"  # restart data every {RESTART_INTERVAL_2D_S:g} s: a cycle run that stops can go on (docs/coupling.md, \"Restarts\")\n"
+                  f"  restart_interval_s: {RESTART_INTERVAL_2D_S:g}\n"
                   "  scheme: SERIAL_EXPLICIT\n"
                   f"  # acoustic estimate mu = 2 rho c dt / (rho_s t) = {2 * BLOOD_DENSITY * c0 * coupling_window(c0) / (leaflet_density(spec.kind) * ValveParameters().thickness):.2f} (the 1D piston's limit is 2);\n"
                   f"  # {COUPLING_WINDOW_FACTOR_2D:g} x the tissue's mu = 1 window, the fluid sub-cycling at CFL {FLUID_CFL_2D:g}; the leaflet\n"

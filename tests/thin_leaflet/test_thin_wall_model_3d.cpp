@@ -153,5 +153,59 @@ TEST(ThinWallModel3D, NodeForcesAreMinusTheForceOnTheFluid) {
   EXPECT_GT(surface[0], 0.0);
 }
 
+TEST(ThinWallModel3D, SmoothedNodeForcesKeepTheForceOnTheFluidAndItsMoment) {
+  // The same block and membrane with the loads spread over 2 dp along the mesh: the loads the
+  // solid receives still sum to minus the force on the fluid and keep the raw loads' moment,
+  // but are not the raw loads.
+  const double dp = 0.02;
+  FluidSettings<3> s = settings(dp);
+  s.domain_lower = {-0.5, -0.5, -0.5};
+  s.domain_upper = {0.5, 0.5, 0.5};
+  SceneGeometry<3> scene;
+  scene.fluid.push_back({{-0.16, -0.16, -0.16}, {0.16, 0.16, 0.16}, {}, [](const Vec<3>& x) { return x[0] < 0 ? 2000.0 : 1000.0; }});
+  const auto g = rectangle_mesh({0.0, -0.1, -0.1}, {0.0, 0.2, 0.0}, {0.0, 0.0, 0.2}, 10, 10);
+  ThinWall3DSettings smoothing;
+  smoothing.load_smoothing_radius_ratio = 2.0;
+  auto model = std::make_unique<ThinWallModel3D>(g, s, smoothing);
+  const ThinWallModel3D* m = model.get();
+  EXPECT_GT(m->load_smoother().mean_neighbours(), 8.0);
+  FluidSolver<3> solver(s, fill_particles<3>(scene, s), {}, std::move(model));
+  const auto& p = solver.particles();
+  Vec3 fluid{0, 0, 0};
+  double magnitude = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.kind[i] != Kind::fluid) continue;
+    for (int d = 0; d < 3; ++d) {
+      fluid[d] += s.particle_mass() * p.acceleration[d][i];
+      magnitude += s.particle_mass() * std::abs(p.acceleration[d][i]);
+    }
+  }
+  std::vector<Vec<3>> sent(m->node_count());
+  m->node_forces(sent);
+  const auto& raw = m->raw_node_forces();
+  Vec3 total{0, 0, 0}, moment_sent{0, 0, 0}, moment_raw{0, 0, 0};
+  double change = 0, scale = 0;
+  auto add_moment = [](Vec3& into, const Vec3& x, const Vec<3>& f) {
+    into[0] += x[1] * f[2] - x[2] * f[1];
+    into[1] += x[2] * f[0] - x[0] * f[2];
+    into[2] += x[0] * f[1] - x[1] * f[0];
+  };
+  for (std::size_t j = 0; j < sent.size(); ++j) {
+    const Vec3 x{g.nodes[j][0], g.nodes[j][1], g.nodes[j][2]};
+    add_moment(moment_sent, x, sent[j]);
+    add_moment(moment_raw, x, raw[j]);
+    for (int d = 0; d < 3; ++d) {
+      total[d] += sent[j][d];
+      change += std::abs(sent[j][d] - raw[j][d]);
+      scale += std::abs(raw[j][d]);
+    }
+  }
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_NEAR(total[d], -fluid[d], 1e-5 * magnitude);
+    EXPECT_NEAR(moment_sent[d], moment_raw[d], 1e-12 * 0.2 * scale);
+  }
+  EXPECT_GT(change, 0.05 * scale);
+}
+
 }  // namespace
 }  // namespace valvefsi::fluid::thin_wall

@@ -128,13 +128,14 @@ def _file_case(setting: dict, work: Path, end_time: float) -> Path:
         raise ValueError(f"case scene: unknown axis '{unknown[0]}': allowed case, set:<block.field>")
     text = case_edit.set_field(source.read_text(), "run.end_time", float(end_time))
     text = case_edit.set_field(text, "run.output_dir", "run")
-    # the copy lives in the work folder: a relative mesh path is made absolute
-    mesh = case_edit.get_field(text, "solid.mesh_file")
-    if mesh and not Path(mesh.strip('"')).is_absolute():
-        text = case_edit.set_field(text, "solid.mesh_file", str(source.parent / mesh.strip('"')))
     for key, value in setting.items():
         if key.startswith("set:"):
             text = case_edit.set_field(text, key[4:], value)
+    # the copy lives in the work folder: a relative mesh path (the case's own or a set: one) is
+    # made absolute from the source case's folder
+    mesh = case_edit.get_field(text, "solid.mesh_file")
+    if mesh and not Path(mesh.strip('"')).is_absolute():
+        text = case_edit.set_field(text, "solid.mesh_file", str(source.parent / mesh.strip('"')))
     work.mkdir(parents=True, exist_ok=True)
     case = work / "case.textproto"
     case.write_text(text)

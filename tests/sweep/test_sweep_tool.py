@@ -124,6 +124,14 @@ class FileCaseScene(unittest.TestCase):
             mesh = Path(case_edit.get_field(text, "solid.mesh_file").strip('"'))
             self.assertTrue(mesh.is_absolute() and mesh.is_file(), mesh)
 
+    def test_a_relative_mesh_set_by_the_sweep_is_made_absolute_from_the_source_case(self):
+        source = Path(__file__).resolve().parents[2] / "cases" / "fe-mhgo-sector-coarse.textproto"
+        with tempfile.TemporaryDirectory() as tmp:
+            case = scenes.write_case("case", {"case": str(source), "set:solid.mesh_file": "meshes/other.mesh.h5"},
+                                     Path(tmp) / "w", 0.12)
+            mesh = case_edit.get_field(case.read_text(), "solid.mesh_file").strip('"')
+            self.assertEqual(Path(mesh), source.parent / "meshes" / "other.mesh.h5")
+
 
     def test_a_case_axis_is_labelled_by_the_file_name(self):
         label = scenes.setting_label({"case": "../cases/fe-mhgo-sector-coarse.textproto",

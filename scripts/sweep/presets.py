@@ -74,10 +74,10 @@ PRESETS = {
             + [{"group": "full valve shell", "setting": {"case": CASES + "fe-mhgo-full-coarse.textproto"}}]
             # the cases' meshes hold triangles only; the bricks' meshes are written beside them by
             # `cd scripts && /usr/bin/python3 -m valve_scene.generate --variant sector --resolution R
-            #  --elements both --out ../cases/meshes/valve-sector-R-both.mesh.h5`
+            #  --elements hexahedra --out ../cases/meshes/valve-sector-R-hexahedra.mesh.h5`
             + [{"group": "sector hexahedron",
                 "setting": {"case": CASES + f"fe-mhgo-sector-{r}.textproto", "set:solid.element_family": "HEXAHEDRON",
-                            "set:solid.mesh_file": f"meshes/valve-sector-{r}-both.mesh.h5"}}
+                            "set:solid.mesh_file": f"meshes/valve-sector-{r}-hexahedra.mesh.h5"}}
                for r in ("coarse", "medium")]
             + [{"group": "sector shell", "setting": {"case": CASES + "fe-mhgo-sector-fine.textproto"}}]
         ),

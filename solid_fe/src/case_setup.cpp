@@ -163,6 +163,7 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.contact_stiffness_factor = solid.contact_stiffness_factor();
   solver_options.max_energy_balance_error = solid.max_energy_balance_error();
   solver_options.fixed_time_step = solid.forced_time_step();
+  solver_options.time_step_look_ahead = solid.time_step_look_ahead();
   if (solver_options.fixed_time_step > 0.0) {
     setup.notes.push_back(fmt::format("forced time step {} s (solid.forced_time_step): no stable-step estimate",
                                       solver_options.fixed_time_step));

@@ -78,6 +78,7 @@ void write_solver_restart(const ExplicitSolver& solver, coupling::RestartWriter&
   file.put("solid/calibrated_step", s.calibrated_step);
   file.put("solid/element_step_at_calibration", s.element_step_at_calibration);
   file.put_integer("solid/calibrated_at_step", s.calibrated_at_step);
+  file.put_integer("solid/stiffening_ahead", s.stiffening_ahead ? 1 : 0);
   file.put_integer("solid/calibration_iterations", s.calibration_iterations);
   put_matrix(file, "solid/power_vector", s.power_vector);
   file.put("solid/contact_omega2", s.contact_omega2);
@@ -148,6 +149,8 @@ void read_solver_restart(const coupling::RestartReader& file, ExplicitSolver& so
   s.calibrated_step = file.scalar("solid/calibrated_step");
   s.element_step_at_calibration = file.scalar("solid/element_step_at_calibration");
   s.calibrated_at_step = file.integer("solid/calibrated_at_step");
+  // (files before the sixth session have no look-ahead state)
+  s.stiffening_ahead = file.has("solid/stiffening_ahead") && file.integer("solid/stiffening_ahead") != 0;
   s.calibration_iterations = static_cast<int>(file.integer("solid/calibration_iterations"));
   s.power_vector = get_nodes(file, "solid/power_vector", n, true);
   s.contact_omega2 = file.scalar("solid/contact_omega2");

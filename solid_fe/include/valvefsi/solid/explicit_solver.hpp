@@ -69,6 +69,9 @@ struct SolverState {
   // (coupled 2D valve: 0.04 us steps where 1 us was stable, 57 steps per 6.5 us window).
   double uncut_step = 0;
   double stable_step = 0;              // current stable step estimate (safety applied)
+  // The look-ahead's bound lay > 10 % below the present one at the last estimate: the mesh is
+  // running into stiffer states, and the step is re-estimated at every step until it is not.
+  bool stiffening_ahead = false;
   std::int64_t critical_element = -1;  // element that sets stable_step
   EnergyBalance energy;
   // Stable-step calibration (Lanczos on M^-1 K): critical step used / element estimate.
@@ -118,6 +121,10 @@ struct SolverOptions {
   double max_step_calibration = 1.5;     // the calibrated step is at most this times the element estimate
   double max_time_step_growth = 0;       // > 0: dt grows by at most this fraction per step
   double fixed_time_step = 0;           // > 0: this step, no estimate (tests of the stability limit)
+  // > 0: the element estimate is also taken at the state the current velocities reach after this
+  // many steps (x + v * look_ahead * dt) and the smaller one used: an element stiffening fast
+  // (MHGO's exponential near a whipping free corner) is resolved before it is met.
+  double time_step_look_ahead = 0;
   // > 0: stop (EnergyGrowthError) when |balance| exceeds this fraction of the largest energy
   // seen, checked every step from step kEnergyCheckFirstStep on; 0 = off.
   double max_energy_balance_error = 0;
@@ -174,6 +181,9 @@ class ExplicitSolver {
     elements_->element_fields(state_.position, max_principal_stress, max_principal_log_strain);
   }
 
+  // Diagnostics: called with the state after every completed step (empty: none).
+  void set_step_observer(std::function<void(const SolverState&)> observer) { step_observer_ = std::move(observer); }
+
   // For tests: the next estimates use dt = factor x the critical-step estimate (safety ignored).
   void set_step_factor_for_testing(double factor) { step_factor_ = factor; }
 
@@ -214,6 +224,7 @@ class ExplicitSolver {
   std::size_t tie_plane_ = 0;           // index of the tie's plane in contact_planes_
   std::vector<std::uint8_t> tie_held_;  // per node: held by a tie now (the tie's plane skips it)
   double step_factor_ = 0.0;     // > 0: tests' override of the safety factor
+  std::function<void(const SolverState&)> step_observer_;
   Eigen::VectorXd half_thickness_;  // per node: contact offset of the surface
   Eigen::Matrix3Xd acceleration_;
   Eigen::Matrix3Xd previous_half_velocity_;  // for the damping work

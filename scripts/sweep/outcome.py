@@ -9,16 +9,16 @@ Kinds (docs/stability-map.md), first match wins:
 - `solid failure`: the solid could not evaluate its material (inverted element, overflow);
 - `coupling divergence`: implicit windows left unconverged, or a step collapse behind a
   runaway leaflet (below);
-- `leaks`: particles crossed a leaflet (fluid_probes.h5 interface/leaks > 0) -- the programs
-  count them but do not stop, so a completed run can end in this class;
+- `leaks`: particles crossed a leaflet (fluid_probes.h5 interface/leaks > 0); the fluid stops
+  above fluid.max_leak_fraction, below it a completed run can end in this class;
 - `energy growth`: the coupler stopped a runaway interface (coupling.max_interface_speed), or
   the interface force beyond any physical bound (|F| > `force_bound`; an
   explicit coupling instability and a fluid instability next to the leaflet look alike here:
   the stability map's "window only" group tells them apart), or a leaflet's free edge faster
   than `speed_bound` (10 m/s, 6x the Bernoulli jet speed of the waveform's peak gradient,
-  1.57 m/s; sound 2D runs stay below 3 m/s over 0-30 ms, measured). The solid's own energy
-  balance error is not used: in coupled runs it is the balance of ~1e-7 J terms and is
-  0.27-0.86 in sound runs (measured);
+  1.57 m/s; sound 2D runs stay below 3 m/s over 0-30 ms, measured), or the solid's own
+  energy-growth stop (solid.max_energy_balance_error; the post-mortem does not re-judge the
+  balance error);
 - `timeout`: stopped at the sweep's wall-time limit;
 - `other`: any other failure (the first error line is kept).
 Detection by the programs is recorded apart from the class: `detected_by` names the program
@@ -40,12 +40,17 @@ PATTERNS = [  # (kind, regex on a log line), checked on error lines first
     ("time-step collapse", re.compile(r"time step collapsed", re.IGNORECASE)),
     ("solid failure", re.compile(r"inverted|overflow|material", re.IGNORECASE)),
     ("coupling divergence", re.compile(r"diverg|not converged", re.IGNORECASE)),
-    # the coupler's runaway check (coupling.max_interface_speed, docs/coupling.md)
-    ("energy growth", re.compile(r"interface is running away", re.IGNORECASE)),
+    # the coupler's runaway check (coupling.max_interface_speed, docs/coupling.md), and the
+    # solid's own energy-growth stop (solid.max_energy_balance_error)
+    ("energy growth", re.compile(r"interface is running away|energy growth at t =", re.IGNORECASE)),
+    # the fluid's leak stop (fluid.max_leak_fraction)
+    ("leaks", re.compile(r"fluid leaks through the leaflets", re.IGNORECASE)),
 ]
 LEAFLET_SPEED = re.compile(r"leaflet node speed ([0-9.eE+-]+) m/s")
 # "[error]" (spdlog's default pattern: fluid_sph, solid_fe) or "12:00:00.000 error" (the coupler's)
-ERROR_LINE = re.compile(r"\[(error|critical)\]|^[0-9:.]+ (error|critical) |run_case: .*failed|error:", re.IGNORECASE)
+# "[solid] solid: ..." / "[fluid] fluid_sph: ...": a program's own stop message, as the launcher prefixes it
+ERROR_LINE = re.compile(r"\[(error|critical)\]|^[0-9:.]+ (error|critical) |run_case: .*failed|error:"
+                        r"|^\[\w+\] (solid|fluid_sph|coupler): ", re.IGNORECASE)
 
 
 @dataclass

@@ -256,6 +256,21 @@ class Classify(unittest.TestCase):
         o = outcome.classify(self.dir, 6, 0.1, launcher_log=launcher)
         self.assertEqual((o.kind, o.detected_by), ("energy growth", "coupler"))
 
+    def test_the_programs_own_stops_are_named(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            run = Path(tmp)
+            (run / "solid.log").write_text(
+                "[solid] t = 0.01720 s (28.7 %), step 40365\n"
+                "[solid] solid: energy growth at t = 0.0196004 s, step 46078: the energy balance error is 0.201\n"
+                "[solid] stopping at t = 0.0196 s\n")
+            ending = outcome.classify(run, 3, 0.06)
+            self.assertEqual((ending.kind, ending.detected_by), ("energy growth", "solid"))
+            (run / "solid.log").write_text("")
+            (run / "fluid.log").write_text(
+                "[fluid] fluid_sph: fluid leaks through the leaflets: 12 particle(s) found on the wrong side\n")
+            ending = outcome.classify(run, 1, 0.06)
+            self.assertEqual((ending.kind, ending.detected_by), ("leaks", "fluid"))
+
     def test_nan_reported_by_the_coupler(self):
         write_logs(self.dir, {"coupler": "[error] coupler: NaN in 'loads' from participant 'fluid' at point 3\n"})
         self.assertEqual(outcome.classify(self.dir, 5, 0.1).kind, "nan")

@@ -36,6 +36,17 @@ SECTOR_SECTION_AZIMUTHS_DEG = (10.0, 25.0, 35.0, 50.0)   # the sector's extra ta
 SKIRT_LAYERS = 3                      # skirt thickness in particle spacings: ceil(2h / dp) at h = 1.3 dp
 SECTOR_SKIRT_MARGIN = math.radians(15.0)  # skirt columns kept beyond the sector's mirror planes
 SECTOR_FILL_LATTICE = "HEX_PRISM"     # the sector's fluid lattice (the full valve keeps CUBIC: no mirror planes)
+# The 3D FSI fluid and window (session 6, docs/thin-leaflet.md "coupled sector"): the 2D valve's
+# stable setting. c0 = 20 m/s (10x the waveform's Bernoulli jet speed, Mach <= 0.1), CFL 0.1,
+# particle shifting, no background pressure (each kernel defect next to a leaflet pushes the blood
+# with ~2 p_b grad(C)/rho: a sector at rest with p_b = 10.8 kPa reached 0.8 m/s, without it stays
+# still), plates that never pull, node loads smoothed over 3 dp, and a 13 us window (mu = 2 for
+# the 0.25 mm leaflet). At the old c0 = 145 m/s and 0.1 ms window (mu = 111) the coupled sector's
+# force grew x100-1000 per window and the solid stopped at 0.82 ms; with these it opened (46.8 ms).
+FSI_3D_SOUND_SPEED = 20.0
+FSI_3D_CFL = 0.1
+FSI_3D_LOAD_SMOOTHING_RADIUS_RATIO = 3.0
+FSI_3D_COUPLING_WINDOW_S = 13.0e-6
 
 
 def _vec(values) -> str:
@@ -111,7 +122,7 @@ def skirt_columns(particle_spacing: float, valve: ValveParameters | None = None,
 
 
 def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = None,
-                valve: ValveParameters | None = None, sound_speed: float = 145.0,
+                valve: ValveParameters | None = None, sound_speed: float = FSI_3D_SOUND_SPEED,
                 sector: bool = False) -> str:
     """The fluid part of a full-valve (or, with sector=True, 1/6-sector) FSI case (3D). The
     sector keeps the full tube's walls, blocks and plates; its two mirror planes leave only the
@@ -146,11 +157,18 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
         "  kernel: CUBIC_SPLINE",
         "  density: 1056",
         "  dynamic_viscosity: 0.0035",
+        "  # the 2D valve's stable fluid (tube_case.FSI_3D_*, docs/thin-leaflet.md): c0 = 10x the jet",
+        "  # speed, CFL 0.1 (the coupling window below sub-cycled), particle shifting",
         f"  sound_speed: {sound_speed:g}",
+        f"  cfl: {FSI_3D_CFL:g}",
+        "  shifting: 1",
         "  density_diffusion: 0.1",
-        f"  # the fluid starts at the aortic pressure at opening ({offset:g} mmHg): background pressure",
-        "  # plus the plates' offset below, so neither plate starts with a step load",
-        f"  background_pressure: {offset * PA_PER_MMHG:.9g}",
+        f"  # no background pressure: gauge 0 is the aortic pressure at opening ({offset:g} mmHg, the",
+        "  # plates' offset below, so neither plate starts with a step load); a background pressure acts",
+        "  # through the leaflets' incomplete kernels. No plate ever pulls on the blood.",
+        "  background_pressure: 0",
+        "  plates_never_pull: true",
+        f"  thin_walls {{ load_smoothing_radius_ratio: {FSI_3D_LOAD_SMOOTHING_RADIUS_RATIO:g} }}",
         f"  domain_lower: {_vec([-margin if sector else -R_tube - margin, -margin if sector else -R_tube - margin, tube_start - margin])}",
         f"  domain_upper: {_vec([R_tube + margin, R_tube + margin, tube_end + margin])}",
         f"  lattice_origin: {_vec([0.0, 0.0, z_inlet])}",

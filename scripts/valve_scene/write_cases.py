@@ -160,8 +160,11 @@ def stent_cylinder_lines() -> str:
 
 
 def coupling_block() -> str:
+    from .tube_case import FSI_3D_COUPLING_WINDOW_S
     return ("coupling {\n"
             "  scheme: SERIAL_EXPLICIT\n"
+            "  # mu = 2 rho_f c0 dt / (rho_s t) = 2 for the 0.25 mm leaflet at c0 = 20 m/s (docs/thin-leaflet.md)\n"
+            f"  window_size: {FSI_3D_COUPLING_WINDOW_S:g}\n"
             "  mapping: NEAREST_PROJECTION\n"
             "}\n")
 

@@ -73,6 +73,15 @@ def _short(value) -> str:
     return f"{value:.4g}" if isinstance(value, float) else str(value)
 
 
+def _axis_value(axis: str, value) -> str:
+    """A table cell for an axis: a case file by its name, an unset axis as '–'."""
+    if value is None:
+        return "–"
+    if axis == "case":
+        return Path(str(value)).name.removesuffix(".textproto")
+    return _short(value)
+
+
 def _pct(value) -> str:
     return "–" if value is None else f"{100 * value:+.1f} %"
 
@@ -105,7 +114,7 @@ def markdown(results: list[dict], finest_label: str | None = None, tolerance: fl
     lines.append("|" + "---|" * len(head))
     for r in rows:
         rss = r["cost"]["peak_rss_mb_by_program"]
-        cells = [_short(r["setting"].get(a)) for a in axes]
+        cells = [_axis_value(a, r["setting"].get(a)) for a in axes]
         kind = r["outcome"]["kind"]
         reached = r["outcome"]["reached_s"]
         cells.append(kind if kind == "completed" else f"{kind} at {_fmt(reached, 1e3, 1)} ms")

@@ -176,6 +176,25 @@ class FieldPeaks(unittest.TestCase):
         # at 50 % of the area the large element (2/3 of it) decides, not the hot small one
         self.assertAlmostEqual(area_percentile([0.9, 0.1, 0.2], [0.5, 0.5, 2.0], 0.5), 0.2)
 
+    def test_a_unit_brick_has_unit_area_and_brick_fields_get_peaks(self):
+        cube = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
+                         [0, 0, 0.1], [1, 0, 0.1], [1, 1, 0.1], [0, 1, 0.1]], float)
+        stretched = cube * [2.0, 1.0, 1.0]
+        nodes = np.vstack([cube, stretched + [5, 0, 0]])
+        bricks = np.array([range(8), range(8, 16)])
+        np.testing.assert_allclose(metrics.hexahedron_mid_areas(nodes, bricks), [1.0, 2.0])
+        with tempfile.TemporaryDirectory() as tmp:
+            with h5py.File(Path(tmp) / "solid_fields.h5", "w") as f:
+                f["mesh/nodes"] = nodes
+                f["mesh/hexahedra"] = bricks
+                g = f.create_group("snapshots/000000")
+                g.attrs["time"] = 0.02
+                g["max_principal_log_strain"] = [0.3, 0.1]   # the small brick is 1/3 of the area
+                g["max_principal_stress"] = [3e6, 1e6]
+            peaks = metrics.field_peaks(Path(tmp))
+            self.assertAlmostEqual(peaks["peak_strain"], 0.3)
+            self.assertAlmostEqual(peaks["peak_stress_time"], 0.02)
+
     def test_no_snapshots_no_peaks(self):
         with tempfile.TemporaryDirectory() as tmp:
             self.assertEqual(metrics.field_peaks(Path(tmp)), {})

@@ -108,8 +108,10 @@ class Valve2dScene(unittest.TestCase):
     def test_mu_of_the_default_is_one_and_scales_with_the_leaflet_mass(self):
         from sweep import stability
         from valve_scene import valve2d
-        self.assertAlmostEqual(stability.mu_of({}), valve2d.COUPLING_WINDOW_FACTOR_2D, delta=0.06)
-        self.assertAlmostEqual(stability.mu_of({"leaflet_density": 275.0}) / stability.mu_of({}), 4.0, places=9)
+        # the sweep's default is the committed coupled case: its leaflet mass and window give mu = 1
+        self.assertEqual(scenes.VALVE2D_DEFAULTS["leaflet_density"], valve2d.leaflet_density("FSI"))
+        self.assertAlmostEqual(stability.mu_of({}), 1.0, delta=0.03)
+        self.assertAlmostEqual(stability.mu_of({"leaflet_density": 275.0}) / stability.mu_of({}), 8.0, places=9)
 
 
 class FileCaseScene(unittest.TestCase):

@@ -122,67 +122,58 @@ TEST(ThinWallModel3D, APairWithAMirrorImageIsBlockedByTheImageLeaflet) {
   }
 }
 
-TEST(ThinWallModel3D, NodeForcesAreMinusTheForceOnTheFluid) {
-  // A block of water round a 0.2 m membrane, 2 kPa on its left and 1 kPa on its right: every
-  // fluid-fluid pair force cancels, so the fluid's total momentum change is the surface's.
-  const double dp = 0.02;
+// A block of water round a 0.2 m membrane, 2 kPa on its left and 1 kPa on its right: every
+// fluid-fluid pair force cancels, so the fluid's total momentum change is the surface's.
+struct PressedMembrane {
+  static constexpr double dp = 0.02;
   FluidSettings<3> s = settings(dp);
-  s.domain_lower = {-0.5, -0.5, -0.5};
-  s.domain_upper = {0.5, 0.5, 0.5};
   SceneGeometry<3> scene;
-  scene.fluid.push_back({{-0.16, -0.16, -0.16}, {0.16, 0.16, 0.16}, {}, [](const Vec<3>& x) { return x[0] < 0 ? 2000.0 : 1000.0; }});
-  const auto g = rectangle_mesh({0.0, -0.1, -0.1}, {0.0, 0.2, 0.0}, {0.0, 0.0, 0.2}, 10, 10);
-  auto model = std::make_unique<ThinWallModel3D>(g, s, ThinWall3DSettings{});
-  const ThinWallModel3D* m = model.get();
-  FluidSolver<3> solver(s, fill_particles<3>(scene, s), {}, std::move(model));
-  const auto& p = solver.particles();
-  Vec3 fluid{0, 0, 0};
-  double magnitude = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (p.kind[i] != Kind::fluid) continue;
-    for (int d = 0; d < 3; ++d) {
-      fluid[d] += s.particle_mass() * p.acceleration[d][i];
-      magnitude += s.particle_mass() * std::abs(p.acceleration[d][i]);
+  ImmersedSurfaceGeometry<3> g = rectangle_mesh({0.0, -0.1, -0.1}, {0.0, 0.2, 0.0}, {0.0, 0.0, 0.2}, 10, 10);
+  const ThinWallModel3D* model = nullptr;
+  std::unique_ptr<FluidSolver<3>> solver;
+  Vec3 force_on_fluid{0, 0, 0};
+  double magnitude = 0;  // sum of |m a| over the fluid: the scale of the round-off
+
+  explicit PressedMembrane(const ThinWall3DSettings& wall) {
+    s.domain_lower = {-0.5, -0.5, -0.5};
+    s.domain_upper = {0.5, 0.5, 0.5};
+    scene.fluid.push_back({{-0.16, -0.16, -0.16}, {0.16, 0.16, 0.16}, {}, [](const Vec<3>& x) { return x[0] < 0 ? 2000.0 : 1000.0; }});
+    auto owned = std::make_unique<ThinWallModel3D>(g, s, wall);
+    model = owned.get();
+    solver = std::make_unique<FluidSolver<3>>(s, fill_particles<3>(scene, s), std::vector<PressurePlate<3>>{}, std::move(owned));
+    const auto& p = solver->particles();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p.kind[i] != Kind::fluid) continue;
+      for (int d = 0; d < 3; ++d) {
+        force_on_fluid[d] += s.particle_mass() * p.acceleration[d][i];
+        magnitude += s.particle_mass() * std::abs(p.acceleration[d][i]);
+      }
     }
   }
-  const Vec3 surface = m->total_force();
+};
+
+TEST(ThinWallModel3D, NodeForcesAreMinusTheForceOnTheFluid) {
+  const PressedMembrane m(ThinWall3DSettings{});
+  const Vec3 surface = m.model->total_force();
+  const Vec3& fluid = m.force_on_fluid;
   std::printf("force on the fluid %.6g %.6g %.6g N, on the nodes %.6g %.6g %.6g N (sum |m a| %.4g N)\n", fluid[0], fluid[1],
-              fluid[2], surface[0], surface[1], surface[2], magnitude);
-  for (int d = 0; d < 3; ++d) EXPECT_NEAR(surface[d], -fluid[d], 1e-5 * magnitude);
+              fluid[2], surface[0], surface[1], surface[2], m.magnitude);
+  for (int d = 0; d < 3; ++d) EXPECT_NEAR(surface[d], -fluid[d], 1e-5 * m.magnitude);
   // The higher pressure is on the left, the membrane's side -1: the load points along +x.
   EXPECT_GT(surface[0], 0.0);
 }
 
 TEST(ThinWallModel3D, SmoothedNodeForcesKeepTheForceOnTheFluidAndItsMoment) {
-  // The same block and membrane with the loads spread over 2 dp along the mesh: the loads the
-  // solid receives still sum to minus the force on the fluid and keep the raw loads' moment,
-  // but are not the raw loads.
-  const double dp = 0.02;
-  FluidSettings<3> s = settings(dp);
-  s.domain_lower = {-0.5, -0.5, -0.5};
-  s.domain_upper = {0.5, 0.5, 0.5};
-  SceneGeometry<3> scene;
-  scene.fluid.push_back({{-0.16, -0.16, -0.16}, {0.16, 0.16, 0.16}, {}, [](const Vec<3>& x) { return x[0] < 0 ? 2000.0 : 1000.0; }});
-  const auto g = rectangle_mesh({0.0, -0.1, -0.1}, {0.0, 0.2, 0.0}, {0.0, 0.0, 0.2}, 10, 10);
+  // The same membrane with the loads spread over 2 dp along the mesh: the loads the solid
+  // receives still sum to minus the force on the fluid and keep the raw loads' moment, but are
+  // not the raw loads.
   ThinWall3DSettings smoothing;
   smoothing.load_smoothing_radius_ratio = 2.0;
-  auto model = std::make_unique<ThinWallModel3D>(g, s, smoothing);
-  const ThinWallModel3D* m = model.get();
-  EXPECT_GT(m->load_smoother().mean_neighbours(), 8.0);
-  FluidSolver<3> solver(s, fill_particles<3>(scene, s), {}, std::move(model));
-  const auto& p = solver.particles();
-  Vec3 fluid{0, 0, 0};
-  double magnitude = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (p.kind[i] != Kind::fluid) continue;
-    for (int d = 0; d < 3; ++d) {
-      fluid[d] += s.particle_mass() * p.acceleration[d][i];
-      magnitude += s.particle_mass() * std::abs(p.acceleration[d][i]);
-    }
-  }
-  std::vector<Vec<3>> sent(m->node_count());
-  m->node_forces(sent);
-  const auto& raw = m->raw_node_forces();
+  const PressedMembrane m(smoothing);
+  EXPECT_GT(m.model->load_smoother().mean_neighbours(), 8.0);
+  std::vector<Vec<3>> sent(m.model->node_count());
+  m.model->node_forces(sent);
+  const auto& raw = m.model->raw_node_forces();
   Vec3 total{0, 0, 0}, moment_sent{0, 0, 0}, moment_raw{0, 0, 0};
   double change = 0, scale = 0;
   auto add_moment = [](Vec3& into, const Vec3& x, const Vec<3>& f) {
@@ -191,7 +182,7 @@ TEST(ThinWallModel3D, SmoothedNodeForcesKeepTheForceOnTheFluidAndItsMoment) {
     into[2] += x[0] * f[1] - x[1] * f[0];
   };
   for (std::size_t j = 0; j < sent.size(); ++j) {
-    const Vec3 x{g.nodes[j][0], g.nodes[j][1], g.nodes[j][2]};
+    const Vec3 x{m.g.nodes[j][0], m.g.nodes[j][1], m.g.nodes[j][2]};
     add_moment(moment_sent, x, sent[j]);
     add_moment(moment_raw, x, raw[j]);
     for (int d = 0; d < 3; ++d) {
@@ -201,7 +192,7 @@ TEST(ThinWallModel3D, SmoothedNodeForcesKeepTheForceOnTheFluidAndItsMoment) {
     }
   }
   for (int d = 0; d < 3; ++d) {
-    EXPECT_NEAR(total[d], -fluid[d], 1e-5 * magnitude);
+    EXPECT_NEAR(total[d], -m.force_on_fluid[d], 1e-5 * m.magnitude);
     EXPECT_NEAR(moment_sent[d], moment_raw[d], 1e-12 * 0.2 * scale);
   }
   EXPECT_GT(change, 0.05 * scale);

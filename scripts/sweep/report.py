@@ -8,6 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from . import metrics as metrics_module
+from . import scenes
 
 SHOWN = [  # (metric, column title, scale, digits)
     ("peak_velocity", "peak v (m/s)", 1.0, 3),
@@ -78,7 +79,7 @@ def _axis_value(axis: str, value) -> str:
     if value is None:
         return "–"
     if axis == "case":
-        return Path(str(value)).name.removesuffix(".textproto")
+        return scenes.case_name(value)
     return _short(value)
 
 

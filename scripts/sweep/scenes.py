@@ -50,13 +50,18 @@ COUPLING_SCHEMES = {
 }
 
 
+def case_name(case) -> str:
+    """A case file's axis value as shown: its file name without the extension."""
+    return Path(str(case)).name.removesuffix(".textproto")
+
+
 def setting_label(setting: dict) -> str:
     """A file-name-safe label: axis=value pairs in the order given."""
     parts = []
     for key, value in setting.items():
         text = f"{value:g}" if isinstance(value, float) else str(value)
         if key == "case":   # a case file: its name says it
-            text = Path(text).name.removesuffix(".textproto")
+            text = case_name(text)
         key = key.replace("set:", "").replace(".", "-")
         parts.append(f"{key}={text}".replace("/", "_").replace(" ", ""))
     return ",".join(parts) if parts else "default"

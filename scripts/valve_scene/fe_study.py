@@ -62,11 +62,15 @@ def run_case(spec: CaseSpec, build_dir: Path, log_dir: Path, runs_dir: Path = RE
            "--output", str(out), "--fe-only", "--build-dir", str(build_dir)]
     log_dir.mkdir(parents=True, exist_ok=True)
     start = time.monotonic()
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     with open(log_dir / f"{spec.name}.log", "w") as log:
         result = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, cwd=REPO)
     wall = time.monotonic() - start
     if result.returncode != 0:
         raise RuntimeError(f"{spec.name}: run_case.py exited with {result.returncode}; see {log_dir / (spec.name + '.log')}")
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
+    (out / "wall_time.json").write_text(json.dumps({"wall_time_s": wall, "cpu_time_s": cpu}))
     return wall
 
 
@@ -360,6 +364,8 @@ def main(argv=None) -> None:
     parser.add_argument("--skip-run", action="store_true", help="analyse existing runs/ folders only")
     parser.add_argument("--report", type=Path, default=REPO / "docs" / "fe-only-study.md")
     parser.add_argument("--cycle", type=int, default=2, help="cycle analysed (1 when the runs stopped in the second)")
+    parser.add_argument("--also-cycles", nargs="*", type=int, default=[],
+                        help="cycles mode: rows for these cycles too (e.g. 1, to show the cycle repeats)")
     parser.add_argument("--cycle-runs-dir", type=Path,
                         help="windows mode: also analyse the two-cycle runs in this folder (rows next to the windows')")
     parser.add_argument("--opening-runs", nargs="*", type=Path, default=[],
@@ -367,8 +373,9 @@ def main(argv=None) -> None:
     parser.add_argument("--notes", type=Path, help="Markdown appended to the report (the discussion)")
     parser.add_argument("--runs-dir", type=Path, default=REPO / "runs", help="where the runs are (RUNS/<case>)")
     args = parser.parse_args(argv)
-    write_cases(CASES_DIR)
-    if not all((CASES_DIR / "meshes" / f"valve-{args.variant}-{r}.mesh.h5").exists() for r in args.resolutions):
+    if not args.skip_run:   # analysing existing runs needs no case files (the mesh is rebuilt)
+        write_cases(CASES_DIR)
+    if not args.skip_run and not all((CASES_DIR / "meshes" / f"valve-{args.variant}-{r}.mesh.h5").exists() for r in args.resolutions):
         write_meshes(CASES_DIR)
     results, opening_dirs = [], []
     for material in args.materials:
@@ -396,8 +403,13 @@ def main(argv=None) -> None:
                     results.append(analyse(spec, args.cycle_runs_dir / spec.name, cycle=args.cycle))
                     results[-1].label = f"{spec.name} (cycle {args.cycle}, {results[-1].mesh_label})"
             else:
-                wall = None if args.skip_run else run_case(spec, args.build_dir, args.runs_dir / "logs", args.runs_dir)
-                results.append(analyse(spec, args.runs_dir / spec.name, cycle=args.cycle, wall_time_s=wall))
+                if not args.skip_run:
+                    run_case(spec, args.build_dir, args.runs_dir / "logs", args.runs_dir)
+                wall, cpu = recorded_times([args.runs_dir / spec.name])   # the run's RUN/wall_time.json
+                for cycle in [*args.also_cycles, args.cycle]:
+                    results.append(analyse(spec, args.runs_dir / spec.name, cycle=cycle, wall_time_s=wall))
+                    results[-1].cpu_time_s = cpu
+                    results[-1].label = f"{spec.name} (cycle {cycle}, {results[-1].mesh_label})"
                 opening_dirs.append(args.runs_dir / spec.name)
             e = results[-1].events
             print(f"{results[-1].label}: wall {results[-1].wall_time_s} s, "

@@ -7,7 +7,9 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from valve_scene.fe_study import analyse, write_report
+import json
+
+from valve_scene.fe_study import analyse, main, write_report
 from valve_scene.valve_mesh import build_valve_mesh
 from valve_scene.write_cases import CaseSpec
 
@@ -41,7 +43,7 @@ def window_fraction(offset):
         else opening_fraction(t)
 
 
-def write_fake_run(run_dir: Path, spec: CaseSpec, end=1.6, fraction=opening_fraction):
+def write_fake_run(run_dir: Path, spec: CaseSpec, end=1.6, fraction=opening_fraction, snapshot_interval=0.005):
     mesh = build_valve_mesh(spec.variant, spec.resolution, "triangles")
     mid = mesh.node_sets["free_edge_midpoints"]
     opening_fraction = fraction
@@ -61,7 +63,7 @@ def write_fake_run(run_dir: Path, spec: CaseSpec, end=1.6, fraction=opening_frac
     with h5py.File(run_dir / "solid_fields.h5", "w") as f:
         f["mesh/nodes"] = mesh.nodes
         f["mesh/triangles"] = mesh.triangles
-        for k, t in enumerate(np.arange(0, end + 1e-9, 0.005)):
+        for k, t in enumerate(np.arange(0, end + 1e-9, snapshot_interval)):
             g = f.create_group(f"snapshots/{k:06d}")
             g.attrs["time"] = t
             frac = float(opening_fraction(t))
@@ -92,6 +94,27 @@ class FeStudyAnalysis(unittest.TestCase):
             text = (run / "report.md").read_text()
             self.assertIn("| fe-ogden-sector-coarse | 5.1 | 10.0 | 240.0 |", text)
             self.assertTrue((run / "figures" / "fe-only-fe-ogden-sector-kinematics.png").exists())
+
+    def test_cycles_mode_reports_each_cycle_with_the_recorded_times(self):
+        spec = CaseSpec("FE", "Ogden", "sector", "coarse")
+        # cycle 1 closes 10 ms later than cycle 2 (230 -> 240 ms against 220 -> 230 ms)
+        def fraction(t):
+            t = np.asarray(t)
+            late = np.interp(np.mod(t, 0.8), [0, 0.005, 0.230, 0.240, 0.8], [0, 0.8, 0.8, 0, 0])
+            early = np.interp(np.mod(t, 0.8), [0, 0.005, 0.220, 0.230, 0.8], [0, 0.8, 0.8, 0, 0])
+            return np.where(t < 0.8, late, early)
+        with tempfile.TemporaryDirectory() as tmp:
+            runs = Path(tmp)
+            write_fake_run(runs / spec.name, spec, fraction=fraction, snapshot_interval=0.05)
+            (runs / spec.name / "wall_time.json").write_text(json.dumps({"wall_time_s": 100.0, "cpu_time_s": 40.0}))
+            main(["--mode", "cycles", "--skip-run", "--materials", "Ogden", "--runs-dir", str(runs),
+                  "--also-cycles", "1", "--report", str(runs / "report.md")])
+            text = (runs / "report.md").read_text()
+            shift = 0.0025 - SMOOTHED_RAMP(0.005) / 2
+            for cycle, closing_mid in ((1, 0.235), (2, 0.225)):
+                et = (closing_mid + SMOOTHED_RAMP(0.010) / 2 - shift) * 1e3
+                self.assertIn(f"| fe-ogden-sector-coarse (cycle {cycle}, sharp commissure) | 5.1 | 10.0 | {et:.1f} |", text)
+            self.assertIn("| 100 / 40 |", text)
 
 
 if __name__ == "__main__":

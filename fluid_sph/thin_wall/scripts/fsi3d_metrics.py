@@ -124,14 +124,18 @@ def summary(fsi: dict, fe: dict | None) -> dict:
     return s
 
 
-def plot(fsi: dict, fe: dict | None, path: Path) -> None:
+def plot(fsi: dict, fe: dict | None, path: Path, others: list | None = None) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(1, 3, figsize=(15, 4))
     so = fsi["solid"]
-    ax[0].plot(so["time_s"] * 1e3, so["radius_m"] * 1e3, "b-", lw=1, label="FSI (coupled sector)")
-    ax[1].plot(so["snapshot_time_s"] * 1e3, so["goa_m2"] * 1e4, "bo-", ms=3, label="FSI")
+    ax[0].plot(so["time_s"] * 1e3, so["radius_m"] * 1e3, "b-", lw=1, label=f"FSI {fsi['label']}")
+    ax[1].plot(so["snapshot_time_s"] * 1e3, so["goa_m2"] * 1e4, "bo-", ms=3, label=f"FSI {fsi['label']}")
+    for other, style in zip(others or [], ("c--", "g--", "y--")):
+        oo = other["solid"]
+        ax[0].plot(oo["time_s"] * 1e3, oo["radius_m"] * 1e3, style, lw=1.2, label=f"FSI {other['label']}")
+        ax[1].plot(oo["snapshot_time_s"] * 1e3, oo["goa_m2"] * 1e4, style, lw=1.2, label=f"FSI {other['label']}")
     if fe is not None:
         ax[0].plot(fe["time_s"] * 1e3, fe["radius_m"] * 1e3, "r-", lw=0.8, label="FE-only sector")
         ax[1].plot(fe["snapshot_time_s"] * 1e3, fe["goa_m2"] * 1e4, "rs-", ms=3, label="FE-only")
@@ -147,10 +151,11 @@ def plot(fsi: dict, fe: dict | None, path: Path) -> None:
                    label="transvalvular pressure drop, 1 ms mean (mmHg)")
         ax[2].plot(t * 1e3, fl["flow_L_per_min"], "m-", lw=0.8, label="flow rate (L/min)")
         ax[2].plot([25], [11.7], "g*", ms=10, label="reference PSPD 11.7 mmHg (MHGO)")
-    for a in ax:
+    ax[2].set_ylim(top=16)
+    for a, where in zip(ax, ("center", "center", "upper left")):
         a.set_xlabel("t (ms)")
         a.grid(alpha=0.3)
-        a.legend(fontsize=7)
+        a.legend(fontsize=7, loc=where)
     fig.suptitle("Coarse 1/6 sector, FSI-MHGO (c0 20 m/s, dp 0.9 mm, 13 us window) against FE-only", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -160,11 +165,16 @@ def plot(fsi: dict, fe: dict | None, path: Path) -> None:
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("run", type=Path)
+    p.add_argument("--label", default="", help="legend label of RUN")
+    p.add_argument("--also", type=Path, nargs="*", default=[], help="more FSI runs drawn beside RUN")
+    p.add_argument("--also-labels", nargs="*", default=[])
     p.add_argument("--fe-only", type=Path)
     p.add_argument("--png", type=Path)
     p.add_argument("--json", type=Path)
     a = p.parse_args(argv)
-    fsi = {"solid": solid_metrics(a.run), "fluid": fluid_metrics(a.run)}
+    fsi = {"solid": solid_metrics(a.run), "fluid": fluid_metrics(a.run), "label": a.label}
+    others = [{"solid": solid_metrics(r), "label": (a.also_labels + [str(r)] * len(a.also))[i]}
+              for i, r in enumerate(a.also)]
     fe = solid_metrics(a.fe_only) if a.fe_only else None
     s = summary(fsi, fe)
     print(json.dumps(s, indent=1))
@@ -176,7 +186,7 @@ def main(argv=None) -> None:
     for t, g, e, st in zip(so["snapshot_time_s"], so["goa_m2"], so["strain_p99"], so["stress_p99_Pa"]):
         print(f"  snapshot {t * 1e3:6.1f} ms: GOA {g * 1e4:.3f} cm^2, strain p99 {e:.3f}, stress p99 {st / 1e6:.3f} MPa")
     if a.png:
-        plot(fsi, fe, a.png)
+        plot(fsi, fe, a.png, others)
     if a.json:
         a.json.write_text(json.dumps(s, indent=1) + "\n")
 

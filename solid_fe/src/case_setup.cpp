@@ -164,6 +164,24 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.max_energy_balance_error = solid.max_energy_balance_error();
   solver_options.fixed_time_step = solid.forced_time_step();
   solver_options.time_step_look_ahead = solid.time_step_look_ahead();
+  if (solid.time_integration() == cases::SolidCase::IMPLICIT) {
+    if (solid.element_family() == cases::SolidCase::HEXAHEDRON) {
+      throw CaseError(fmt::format("{}: field 'solid.time_integration' = IMPLICIT with solid.element_family = "
+                                  "HEXAHEDRON: allowed only for SHELL (no brick tangent yet)", source));
+    }
+    if (setup.dimension == 2) {
+      throw CaseError(fmt::format("{}: field 'solid.time_integration' = IMPLICIT with run.dimension = 2: allowed "
+                                  "only in 3D (2D strip ties are not in the implicit path)", source));
+    }
+    solver_options.time_integration = TimeIntegration::implicit_generalized_alpha;
+    solver_options.spectral_radius_infinity = solid.spectral_radius_infinity();
+    solver_options.implicit_initial_step = solid.implicit_initial_step_s();
+    solver_options.implicit_min_step = solid.implicit_min_step_s();
+    solver_options.newton_tolerance = solid.newton_tolerance();
+    solver_options.newton_max_iterations = solid.newton_max_iterations();
+    setup.notes.push_back(fmt::format("implicit dynamics: generalized-alpha, rho_inf = {}, Newton tolerance {}",
+                                      solver_options.spectral_radius_infinity, solver_options.newton_tolerance));
+  }
   if (solver_options.fixed_time_step > 0.0) {
     setup.notes.push_back(fmt::format("forced time step {} s (solid.forced_time_step): no stable-step estimate",
                                       solver_options.fixed_time_step));

@@ -5,6 +5,7 @@
 // 8-node brick (hexahedron_elements.hpp); docs/solid_fe.md, "One integrator, two element models".
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,13 @@ struct ElementContribution {
   double stable_step = std::numeric_limits<double>::infinity();  // its critical step, no safety (s)
 };
 
+// One 3x3 block of a tangent: d(force at node `row`) / d(position of node `col`).
+struct NodeBlock {
+  std::int32_t row = 0;
+  std::int32_t col = 0;
+  Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
+};
+
 // Below this many elements thread start-up costs more than it saves.
 inline constexpr std::int64_t kMinElementsForThreads = 1000;
 
@@ -60,6 +68,17 @@ class ElementModel {
   // cannot be evaluated).
   virtual void element_fields(const Eigen::Matrix3Xd& x, Eigen::VectorXd& max_principal_stress,
                               Eigen::VectorXd& max_principal_log_strain) const = 0;
+  // Implicit dynamics (implicit_dynamics.cpp): the tangent d f_int / dx at x as node blocks, the
+  // same blocks in the same order at every call (the sparse pattern is analysed once).
+  virtual void internal_force_tangent(const Eigen::Matrix3Xd& /*x*/, std::vector<NodeBlock>& /*blocks*/) {
+    throw std::invalid_argument(fmt::format("solid: implicit time integration is not available for {} elements "
+                                            "(allowed: shell)", family()));
+  }
+  // Appends d f_pressure / dx of the follower pressure dp (Pa) at x (no blocks when dp = 0).
+  virtual void add_pressure_tangent(const Eigen::Matrix3Xd& /*x*/, double /*dp*/, std::vector<NodeBlock>& /*blocks*/) const {
+    throw std::invalid_argument(fmt::format("solid: implicit time integration is not available for {} elements "
+                                            "(allowed: shell)", family()));
+  }
   // The triangle surface leaflet-leaflet contact works on (shells only; nullptr otherwise).
   virtual const ShellModel* contact_surface() const { return nullptr; }
 

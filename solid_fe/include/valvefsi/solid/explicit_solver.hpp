@@ -31,6 +31,10 @@ struct EnergyBalance {
   double contact_work = 0;      // stored/dissipated in contact penalties (J)
   double tie_work = 0;          // done against coaptation ties: stored now + lost at releases (J)
   double tie_energy = 0;        // stored in the tied springs now (J)
+  // Implicit dynamics only: work of the net force (trapezoidal, as booked above) that did not
+  // reach the kinetic energy, i.e. removed by the generalized-alpha scheme's high-frequency
+  // damping (J); 0 for rho_inf = 1 up to the Newton tolerance, and for the explicit integrator.
+  double numerical_dissipation = 0;
   // Coupled runs: the work of the coupler's loads as the coupler books it, sum over windows of
   // F_w . v(window start) * window size (J; 2D: the coupler's J/m times the strip depth). The
   // solid's own external_work books F_w . (x_end - x_start); the two differ by the explicit
@@ -41,7 +45,8 @@ struct EnergyBalance {
   double largest_energy = 0;
   // KE + W_int + W_damp + W_contact + W_tie - W_ext - KE0: zero for exact time integration.
   double balance() const {
-    return kinetic + internal_work + damping_work + contact_work + tie_work - external_work - initial_kinetic;
+    return kinetic + internal_work + damping_work + contact_work + tie_work + numerical_dissipation - external_work -
+           initial_kinetic;
   }
   // |balance| relative to the largest energy term now.
   double relative_balance_error() const;
@@ -87,6 +92,11 @@ struct SolverState {
   double contact_omega2 = 0.0;
   ContactCandidates contact_candidates;
   CoaptationTieState tie;
+  // Implicit dynamics: the acceleration at `time` (empty until the first implicit step), the step
+  // proposed for the next one and the Newton iterations of the last one.
+  Eigen::Matrix3Xd acceleration;
+  double implicit_step = 0;
+  int newton_iterations = 0;
 };
 
 struct SymmetryConstraint {
@@ -105,6 +115,11 @@ struct ContactCylinder {
 struct StripTie {
   std::int64_t front;
   std::int64_t back;
+};
+
+enum class TimeIntegration {
+  explicit_central_difference,  // the default: lumped-mass central difference, stable-step bound
+  implicit_generalized_alpha,   // Newton on each step, adaptive step (implicit_dynamics.cpp)
 };
 
 struct SolverOptions {
@@ -128,6 +143,17 @@ struct SolverOptions {
   // > 0: stop (EnergyGrowthError) when |balance| exceeds this fraction of the largest energy
   // seen, checked every step from step kEnergyCheckFirstStep on; 0 = off.
   double max_energy_balance_error = 0;
+  // Implicit dynamics (docs/solid_fe.md, "Implicit dynamics"): generalized-alpha (Chung & Hulbert
+  // 1993) with spectral radius rho_inf at infinite frequency (1 = average acceleration, no
+  // dissipation; 0 = asymptotic annihilation); Newton converges when the residual's norm is below
+  // newton_tolerance x the largest of the inertia, internal and external forces' norms.
+  TimeIntegration time_integration = TimeIntegration::explicit_central_difference;
+  double spectral_radius_infinity = 0.8;
+  double implicit_initial_step = 1e-6;  // first step (s)
+  double implicit_min_step = 1e-10;     // a step cut below this stops the run (NewtonFailureError)
+  double newton_tolerance = 1e-6;
+  int newton_max_iterations = 10;
+  int newton_fast_iterations = 3;       // converged within this many: the next step grows by 1.25
 };
 
 // The energy-growth check starts here: the first steps' balance is a ratio of round-off-sized
@@ -166,6 +192,7 @@ class ExplicitSolver {
   // Advances to exactly t_end under `nodal_forces` (3 x nodes, N; constant over the window)
   // added to the pressure load. Throws MaterialStateError naming the element, time and step.
   void advance_window(double t_end, const Eigen::Matrix3Xd* nodal_forces = nullptr);
+  bool implicit() const { return options_.time_integration == TimeIntegration::implicit_generalized_alpha; }
 
   const SolverState& state() const { return state_; }
   void restore(const SolverState& saved) {
@@ -209,6 +236,12 @@ class ExplicitSolver {
   // Throws EnergyGrowthError when the balance error passes options_.max_energy_balance_error.
   void check_energy_growth() const;
   void add_work(const Eigen::Matrix3Xd& dx);
+  // Implicit dynamics (implicit_dynamics.cpp): the window loop, one step of size h from the
+  // present state (false when Newton did not converge; the state is then unchanged), and the
+  // per-node constraint projectors.
+  void advance_window_implicit(double t_end, const Eigen::Matrix3Xd* nodal_forces);
+  bool implicit_step(double h, const Eigen::Matrix3Xd* nodal_forces, double& residual, Eigen::Index& worst_node);
+  void prepare_implicit();
   bool has_contact() const { return !contact_planes_.empty() || !contact_cylinders_.empty() || leaflet_contact_; }
 
   std::unique_ptr<ElementModel> elements_;
@@ -231,6 +264,8 @@ class ExplicitSolver {
   Eigen::Matrix3Xd probe_position_, probe_force_, probe_vector_;  // calibration work arrays
   std::vector<Eigen::Matrix3Xd> lanczos_basis_;
   Eigen::Matrix3Xd step_increment_;
+  struct ImplicitWork;  // sparse matrices, factorisation and work arrays of implicit dynamics
+  std::shared_ptr<ImplicitWork> implicit_;
   bool internal_force_current_ = false;
   SolverState state_;
 };

@@ -28,6 +28,9 @@ class ShellElements final : public ElementModel {
   void element_fields(const Eigen::Matrix3Xd& x, Eigen::VectorXd& max_principal_stress,
                       Eigen::VectorXd& max_principal_log_strain) const override;
   const ShellModel* contact_surface() const override { return &model_; }
+  // Element-level forward-difference tangent of the exact element forces (shell_tangent.cpp).
+  void internal_force_tangent(const Eigen::Matrix3Xd& x, std::vector<NodeBlock>& blocks) override;
+  void add_pressure_tangent(const Eigen::Matrix3Xd& x, double dp, std::vector<NodeBlock>& blocks) const override;
 
   // Triangles the pressure loads (all when empty); throws std::invalid_argument for a bad index.
   void set_pressure_elements(std::vector<std::int64_t> elements);

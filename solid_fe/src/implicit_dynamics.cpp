@@ -1,0 +1,296 @@
+// Implicit dynamics of ExplicitSolver (solid.time_integration: IMPLICIT; docs/solid_fe.md,
+// "Implicit dynamics"): generalized-alpha (Chung & Hulbert 1993, forces interpolated between the
+// step's ends) with Newton-Raphson on the step's residual, an Eigen SparseLU solve (follower
+// pressure and penalty contact make the tangent non-symmetric) and an adaptive step that grows
+// when Newton converges fast and is cut and retried when it does not. Same fixed nodes, mirror
+// planes, contact and follower pressure as the explicit path, which it replaces step for step.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <fmt/format.h>
+
+#include "valvefsi/solid/energy_growth_error.hpp"
+#include "valvefsi/solid/explicit_solver.hpp"
+#include "valvefsi/solid/material_error.hpp"
+#include "valvefsi/solid/newton_failure_error.hpp"
+
+namespace valvefsi::solid {
+
+struct ExplicitSolver::ImplicitWork {
+  std::vector<Eigen::Matrix3d> projector;  // per node: the constraints as a 3x3 projector (0: fixed)
+  std::vector<std::uint8_t> constrained;   // per node: projector is not the identity
+  std::vector<NodeBlock> blocks;
+  std::vector<Eigen::Triplet<double>> triplets;
+  Eigen::SparseMatrix<double> matrix;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
+  Eigen::Index analysed_nonzeros = -1;  // pattern of the last analysis (constant in practice)
+  Eigen::Matrix3Xd dx, a, v, r, net, net_n;
+  Eigen::VectorXd delta;
+};
+
+namespace {
+
+struct AlphaParameters {
+  double alpha_m, alpha_f, gamma, beta;
+};
+
+// Chung & Hulbert's optimal set for a given spectral radius at infinite frequency.
+AlphaParameters alpha_parameters(double rho_inf) {
+  AlphaParameters p{};
+  p.alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+  p.alpha_f = rho_inf / (rho_inf + 1.0);
+  p.gamma = 0.5 - p.alpha_m + p.alpha_f;
+  p.beta = 0.25 * (1.0 - p.alpha_m + p.alpha_f) * (1.0 - p.alpha_m + p.alpha_f);
+  return p;
+}
+
+}  // namespace
+
+void ExplicitSolver::prepare_implicit() {
+  if (planar_ || tie_) {
+    throw std::invalid_argument(
+        "solid: time_integration IMPLICIT is not available with 2D strips or a coaptation tie (allowed: EXPLICIT)");
+  }
+  const double rho = options_.spectral_radius_infinity;
+  if (!(rho >= 0.0 && rho <= 1.0)) {
+    throw std::invalid_argument(fmt::format("solid: spectral_radius_infinity = {}: allowed [0, 1]", rho));
+  }
+  implicit_ = std::make_shared<ImplicitWork>();
+  const Eigen::Index n = elements_->reference_positions().cols();
+  implicit_->projector.assign(static_cast<std::size_t>(n), Eigen::Matrix3d::Identity());
+  implicit_->constrained.assign(static_cast<std::size_t>(n), 0);
+  // The constraints are linear per node (no strip ties here): their projector is their action on
+  // the three unit vectors.
+  Eigen::Matrix3Xd unit(3, n);
+  for (int d = 0; d < 3; ++d) {
+    unit.setZero();
+    unit.row(d).setOnes();
+    apply_constraints(unit);
+    for (Eigen::Index i = 0; i < n; ++i) implicit_->projector[static_cast<std::size_t>(i)].col(d) = unit.col(i);
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    implicit_->constrained[k] = !implicit_->projector[k].isIdentity(0.0);
+  }
+}
+
+bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_forces, double& residual,
+                                   Eigen::Index& worst_node) {
+  ImplicitWork& w = *implicit_;
+  const AlphaParameters p = alpha_parameters(options_.spectral_radius_infinity);
+  const Eigen::ArrayXd mass = elements_->nodal_mass().array();
+  const double damping = options_.mass_damping_per_s;
+  const SolverState start = state_;  // restored when Newton fails
+  const Eigen::Matrix3Xd& x_n = start.position;
+  const Eigen::Matrix3Xd& v_n = start.velocity;
+  const Eigen::Matrix3Xd& a_n = start.acceleration;
+  w.net_n = start.external_force + start.contact_force - start.internal_force;
+  const double t_new = state_.time + h;
+  const Eigen::Index n = x_n.cols();
+
+  // Predictor: the same acceleration as now. The unknown is the increment dx, not x: at small
+  // steps x - x_n would lose the acceleration to round-off (1e-16 x 2 cm / h^2).
+  w.dx = h * v_n + 0.5 * h * h * a_n;
+  const double mass_coefficient = (1.0 - p.alpha_m) / (p.beta * h * h) + damping * (1.0 - p.alpha_f) * p.gamma / (p.beta * h);
+  const double stiffness_coefficient = 1.0 - p.alpha_f;
+  residual = std::numeric_limits<double>::infinity();
+  worst_node = -1;
+  const auto fail = [&] {
+    state_ = start;
+    internal_force_current_ = true;
+    return false;
+  };
+  // Converged also when the last correction was at round-off of the positions (1e-12 of the
+  // model's size): near rest every force is itself round-off and the relative residual stalls.
+  const Eigen::Matrix3Xd& reference = elements_->reference_positions();
+  const double round_off = 1e-12 * (reference.rowwise().maxCoeff() - reference.rowwise().minCoeff()).norm();
+  double correction = std::numeric_limits<double>::infinity();
+  for (int iteration = 0;; ++iteration) {
+    state_.position = x_n + w.dx;
+    state_.time = t_new;
+    try {
+      compute_internal_force(false);
+      compute_contact_force();
+      compute_external_force(t_new, nodal_forces);
+    } catch (const MaterialStateError&) {
+      return fail();  // a trial state the material cannot take: a smaller step will not go there
+    }
+    w.a = (w.dx - h * v_n - h * h * (0.5 - p.beta) * a_n) / (p.beta * h * h);
+    w.v = v_n + h * ((1.0 - p.gamma) * a_n + p.gamma * w.a);
+    w.net = state_.external_force + state_.contact_force - state_.internal_force;
+    // Inertia (and mass damping) at n+1-alpha_m (n+1-alpha_f) against the forces at n+1-alpha_f.
+    w.r = ((1.0 - p.alpha_m) * w.a + p.alpha_m * a_n + damping * ((1.0 - p.alpha_f) * w.v + p.alpha_f * v_n))
+              .array()
+              .rowwise() *
+          mass.transpose();
+    w.r -= (1.0 - p.alpha_f) * w.net + p.alpha_f * w.net_n;
+    apply_constraints(w.r);
+    const double scale = std::max({(w.a.array().rowwise() * mass.transpose()).matrix().norm(),
+                                   state_.internal_force.norm(), state_.external_force.norm(),
+                                   state_.contact_force.norm(), w.net_n.norm(), 1e-300});
+    residual = w.r.norm() / scale;
+    if (!std::isfinite(residual)) return fail();
+    if (std::getenv("VALVEFSI_NEWTON_DEBUG") != nullptr) {
+      std::fprintf(stderr, "t %.6g h %.3g it %d residual %.3g scale %.3g\n", t_new, h, iteration, residual, scale);
+    }
+    w.r.colwise().norm().maxCoeff(&worst_node);
+    if (residual <= options_.newton_tolerance || correction <= round_off) {
+      state_.newton_iterations = iteration;
+      break;
+    }
+    if (iteration >= options_.newton_max_iterations) return fail();
+
+    // Tangent: mass_coefficient M + (1 - alpha_f) (K_int - K_pressure + K_contact), constrained
+    // rows and columns projected, their diagonal kept at the mass term so the matrix stays regular.
+    const auto clock0 = std::chrono::steady_clock::now();
+    try {
+      elements_->internal_force_tangent(state_.position, w.blocks);
+    } catch (const MaterialStateError&) {
+      return fail();
+    }
+    const std::size_t internal_blocks = w.blocks.size();
+    if (pressure_) elements_->add_pressure_tangent(state_.position, pressure_(t_new), w.blocks);
+    w.triplets.clear();
+    w.triplets.reserve(9 * (w.blocks.size() + static_cast<std::size_t>(n)));
+    const auto add_block = [&](std::int32_t row, std::int32_t col, const Eigen::Matrix3d& k) {
+      Eigen::Matrix3d b = k;
+      if (w.constrained[static_cast<std::size_t>(row)]) b = w.projector[static_cast<std::size_t>(row)] * b;
+      if (w.constrained[static_cast<std::size_t>(col)]) b = b * w.projector[static_cast<std::size_t>(col)];
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) w.triplets.emplace_back(3 * row + i, 3 * col + j, b(i, j));
+      }
+    };
+    for (std::size_t k = 0; k < w.blocks.size(); ++k) {
+      const double sign = k < internal_blocks ? stiffness_coefficient : -stiffness_coefficient;
+      add_block(w.blocks[k].row, w.blocks[k].col, sign * w.blocks[k].k);
+    }
+    // Penalty contact: k n n^T along each contact force (exact for one plane or cylinder per node;
+    // for leaflet-leaflet contact only the node's own part, the residual stays exact).
+    const double penalty = options_.contact_stiffness_factor * state_.contact_omega2;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const auto node = static_cast<std::int32_t>(i);
+      const double f = state_.contact_force.col(i).norm();
+      if (f > 0.0) {
+        const Eigen::Vector3d u = state_.contact_force.col(i) / f;
+        add_block(node, node, (stiffness_coefficient * penalty * mass(i)) * (u * u.transpose()));
+      }
+      add_block(node, node, Eigen::Matrix3d::Zero());  // keeps the pattern whether in contact or not
+      for (int d = 0; d < 3; ++d) w.triplets.emplace_back(3 * node + d, 3 * node + d, mass_coefficient * mass(i));
+    }
+    const auto clock1 = std::chrono::steady_clock::now();
+    w.matrix.resize(3 * n, 3 * n);
+    w.matrix.setFromTriplets(w.triplets.begin(), w.triplets.end());
+    if (w.matrix.nonZeros() != w.analysed_nonzeros) {
+      w.lu.analyzePattern(w.matrix);
+      w.analysed_nonzeros = w.matrix.nonZeros();
+    }
+    const auto clock2 = std::chrono::steady_clock::now();
+    w.lu.factorize(w.matrix);
+    if (w.lu.info() != Eigen::Success) return fail();
+    w.delta = w.lu.solve(-Eigen::Map<const Eigen::VectorXd>(w.r.data(), 3 * n));
+    if (w.lu.info() != Eigen::Success || !w.delta.allFinite()) return fail();
+    w.r = Eigen::Map<const Eigen::Matrix3Xd>(w.delta.data(), 3, n);
+    apply_constraints(w.r);
+    w.dx += w.r;
+    correction = w.r.cwiseAbs().maxCoeff();
+    if (std::getenv("VALVEFSI_NEWTON_DEBUG") != nullptr) {
+      const auto clock3 = std::chrono::steady_clock::now();
+      std::fprintf(stderr, "timing tangent %.3g ms assemble %.3g ms factor+solve %.3g ms nnz %ld\n",
+                   std::chrono::duration<double, std::milli>(clock1 - clock0).count(),
+                   std::chrono::duration<double, std::milli>(clock2 - clock1).count(),
+                   std::chrono::duration<double, std::milli>(clock3 - clock2).count(), static_cast<long>(w.matrix.nonZeros()));
+    }
+  }
+
+  // Converged: the state at t_new, and the step's booking (trapezoidal works as the explicit
+  // ledger; what the net force's work did not put into kinetic energy is the scheme's dissipation).
+  state_.velocity = w.v;
+  state_.half_step_velocity = w.v;
+  state_.acceleration = w.a;
+  ++state_.step;
+  state_.last_step = h;
+  const Eigen::Matrix3Xd& dx = w.dx;
+  EnergyBalance& e = state_.energy;
+  const double kinetic_before = e.kinetic;
+  const double internal = 0.5 * (start.internal_force + state_.internal_force).cwiseProduct(dx).sum();
+  const double external = 0.5 * (start.external_force + state_.external_force).cwiseProduct(dx).sum();
+  const double contact = -0.5 * (start.contact_force + state_.contact_force).cwiseProduct(dx).sum();
+  double damped = 0.0;
+  if (damping > 0.0) {
+    for (Eigen::Index i = 0; i < n; ++i) damped += damping * mass(i) * 0.5 * (v_n.col(i) + w.v.col(i)).dot(dx.col(i));
+  }
+  e.internal_work += internal;
+  e.external_work += external;
+  e.contact_work += contact;
+  e.damping_work += damped;
+  update_kinetic_energy();
+  e.numerical_dissipation += external - internal - contact - damped - (e.kinetic - kinetic_before);
+  return true;
+}
+
+void ExplicitSolver::advance_window_implicit(double t_end, const Eigen::Matrix3Xd* nodal_forces) {
+  if (!implicit_) prepare_implicit();
+  const Eigen::Index n = state_.position.cols();
+  compute_external_force(state_.time, nodal_forces);  // this window's load at its start
+  if (state_.acceleration.cols() != n) {
+    // Start (or the switch from explicit): the acceleration the equation of motion gives now.
+    compute_acceleration(elements_->nodal_mass().array().inverse());
+    state_.acceleration = acceleration_ - options_.mass_damping_per_s * state_.velocity;
+    apply_constraints(state_.acceleration);
+  }
+  double h = state_.implicit_step > 0.0 ? state_.implicit_step : options_.implicit_initial_step;
+  while (state_.time < t_end) {
+    h = std::min(h, options_.max_time_step);
+    const double remaining = t_end - state_.time;
+    double step = h;
+    bool lands = false;
+    if (remaining <= h * (1.0 + 1e-9)) {
+      step = remaining;
+      lands = true;
+    } else if (remaining < 2.0 * h) {
+      step = 0.5 * remaining;  // no sliver step before the window's end
+    }
+    double residual = 0.0;
+    Eigen::Index worst = -1;
+    if (implicit_step(step, nodal_forces, residual, worst)) {
+      if (lands) state_.time = t_end;
+      // Grow after fast convergence, shrink after slow; a step cut to land on the window's end
+      // does not set the next one.
+      if (state_.newton_iterations <= options_.newton_fast_iterations) {
+        h = std::max(h, step) * 1.25;
+      } else if (state_.newton_iterations >= options_.newton_max_iterations - 2) {
+        h = step * 0.7;
+      }
+      state_.implicit_step = h;
+      state_.stable_step = h;
+      state_.critical_element = -1;
+      state_.step_calibration = 1.0;
+      state_.energy.update_largest_energy();
+      if (step_observer_) step_observer_(state_);
+      if (options_.max_energy_balance_error > 0.0 && state_.step >= kEnergyCheckFirstStep) check_energy_growth();
+      continue;
+    }
+    h = 0.25 * step;
+    if (h < options_.implicit_min_step) {
+      const Eigen::Vector3d xw = worst >= 0 ? Eigen::Vector3d(state_.position.col(worst)) : Eigen::Vector3d::Zero();
+      throw NewtonFailureError(fmt::format(
+          "solid: implicit step failed at t = {:.9g} s, step {}: Newton did not converge within {} iterations even "
+          "at dt = {:.3g} s (cut below solid.implicit_min_step_s = {:.3g} s); last relative residual {:.3g} "
+          "(tolerance {:.3g}), largest at node {} (at [{:.4g}, {:.4g}, {:.4g}] m). Raise "
+          "solid.newton_max_iterations, lower solid.implicit_min_step_s, or use time_integration: EXPLICIT.",
+          state_.time, state_.step, options_.newton_max_iterations, step, options_.implicit_min_step, residual,
+          options_.newton_tolerance, worst, xw.x(), xw.y(), xw.z()));
+    }
+  }
+}
+
+}  // namespace valvefsi::solid

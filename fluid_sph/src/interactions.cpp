@@ -1,6 +1,7 @@
 #include "valvefsi/fluid/interactions.hpp"
 
 #include <omp.h>
+#include <xsimd/xsimd.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -229,11 +230,161 @@ inline void add_neighbour(LaneBlock& L, const Neighbour& b, int padded, const Pa
   }
 }
 
+// The vector of the register passes: 8 floats where AVX2 exists (on Zen 4 a 512-bit op costs
+// two 256-bit ones, so 8 lanes lose nothing), else the widest the build targets.
+#if XSIMD_WITH_AVX2
+using LaneBatch = xsimd::batch<float, xsimd::avx2>;
+#else
+using LaneBatch = xsimd::batch<float>;
+#endif
+constexpr int kBatch = static_cast<int>(LaneBatch::size);
+static_assert(kBlock % kBatch == 0, "a lane block must be a whole number of vectors");
+
+// The kernels of kernels.hpp on a vector of distances (same arithmetic as the scalar ones).
+template <int D>
+inline LaneBatch gradient_factor(const WendlandC2Kernel<D>& W, const LaneBatch& r) {
+  const LaneBatch q = r * W.inv_h;
+  const LaneBatch s = xsimd::max(LaneBatch(1.0f) - 0.5f * q, LaneBatch(0.0f));
+  return (W.gradient_scale * -5.0f) * s * s * s;
+}
+template <int D>
+inline LaneBatch kernel_value(const WendlandC2Kernel<D>& W, const LaneBatch& r) {
+  const LaneBatch q = r * W.inv_h;
+  const LaneBatch s = xsimd::max(LaneBatch(1.0f) - 0.5f * q, LaneBatch(0.0f));
+  const LaneBatch s2 = s * s;
+  return W.value_scale * s2 * s2 * (2.0f * q + 1.0f);
+}
+template <int D>
+inline LaneBatch gradient_factor(const CubicSplineKernel<D>& W, const LaneBatch& r) {
+  const LaneBatch q = r * W.inv_h;
+  const LaneBatch t = xsimd::max(LaneBatch(2.0f) - q, LaneBatch(0.0f));
+  const LaneBatch outer = -0.75f * t * t / xsimd::max(q, LaneBatch(1.0f));
+  const LaneBatch inner = -3.0f + 2.25f * q;
+  return W.gradient_scale * xsimd::select(q < 1.0f, inner, outer);
+}
+template <int D>
+inline LaneBatch kernel_value(const CubicSplineKernel<D>& W, const LaneBatch& r) {
+  const LaneBatch q = r * W.inv_h;
+  const LaneBatch t = xsimd::max(LaneBatch(2.0f) - q, LaneBatch(0.0f));
+  const LaneBatch outer = 0.25f * t * t * t;
+  const LaneBatch inner = 1.0f - 1.5f * q * q + 0.75f * q * q * q;
+  return W.value_scale * xsimd::select(q < 1.0f, inner, outer);
+}
+
+// The neighbours of one block that passed the box test, as broadcast records: the plain ones
+// and, per booked body, that body's walls (their pair terms are also summed on their own, as
+// the body's reaction). Each list is swept once over all lanes.
+// The buffers are sized to the block's candidates before filling (no push_back in the loop).
+struct NeighbourLists {
+  std::vector<Neighbour> plain;
+  std::array<std::vector<Neighbour>, kMaxBookedBodies> booked;
+  std::size_t plain_count = 0;
+  std::array<std::size_t, kMaxBookedBodies> booked_count{};
+  void make_room(std::size_t candidates, bool with_bodies) {
+    if (plain.size() < candidates) plain.resize(candidates);
+    if (with_bodies)
+      for (auto& b : booked)
+        if (b.size() < candidates) b.resize(candidates);
+  }
+};
+
+// The same sums as add_neighbour for a whole list of neighbours, with the lanes' state and
+// sums held in registers (C vectors of lanes) for the length of the list: no per-pair load and
+// store of the per-lane sums. acc: where the list's accelerations are summed (the block's own
+// sums, or a body's booking). Viscous: false when mu = 0 (the term is then exactly zero).
+template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Viscous, int C, class Kernel>
+inline void sweep_neighbours(LaneBlock& L, const Neighbour* nb, std::size_t count, float (*acc)[kBlock],
+                             const PairConstants<D>& k, const Kernel& W) {
+  using B = LaneBatch;
+  constexpr int S = kBatch;
+  B x[3][C], v[3][C], w[3][C], p_wall[C], p_rest[C], inv[C], ex[C];
+  B ax[3][C], cont[C], diff[C], csum[C], cg[3][C];
+  for (int c = 0; c < C; ++c) {
+    const int o = c * S;
+    for (int d = 0; d < D; ++d) {
+      x[d][c] = B::load_aligned(&L.x[d][o]);
+      v[d][c] = B::load_aligned(&L.v[d][o]);
+      if constexpr (Viscous) w[d][c] = B::load_aligned(&L.w[d][o]);
+      ax[d][c] = B::load_aligned(&acc[d][o]);
+      if constexpr (WithKernelSum) cg[d][c] = B::load_aligned(&L.cg[d][o]);
+    }
+    const B p = B::load_aligned(&L.p[o]);
+    // Against a wall only the fluid's positive pressure counts (walls push, never pull).
+    p_wall[c] = xsimd::max(p, B(0.0f));
+    p_rest[c] = p - p_wall[c];
+    inv[c] = B::load_aligned(&L.inv[o]);
+    ex[c] = B::load_aligned(&L.ex[o]);
+    cont[c] = B::load_aligned(&L.cont[o]);
+    diff[c] = B::load_aligned(&L.diff[o]);
+    if constexpr (WithKernelSum) csum[c] = B::load_aligned(&L.csum[o]);
+  }
+  for (std::size_t j = 0; j < count; ++j) {
+    const Neighbour& b = nb[j];
+    for (int c = 0; c < C; ++c) {
+      const B dx = x[0][c] - b.x, dy = x[1][c] - b.y;
+      const B dz = D == 3 ? x[D - 1][c] - b.z : B(0.0f);
+      B r2 = dx * dx + dy * dy;
+      if constexpr (D == 3) r2 += dz * dz;
+      const B r = xsimd::sqrt(r2);
+      const B F = gradient_factor(W, r);
+      const B inv_rr = inv[c] * b.inv;
+      B vdx = (v[0][c] - b.vx) * dx + (v[1][c] - b.vy) * dy;
+      if constexpr (D == 3) vdx += (v[D - 1][c] - b.vz) * dz;
+      cont[c] += vdx * F;
+      B radial = -(b.p + p_wall[c] + b.fluid * p_rest[c]) * inv_rr;
+      if constexpr (WithArtificialViscosity) {
+        const B mu_ab = k.h * xsimd::min(vdx, B(0.0f)) / (r2 + k.eta2);
+        radial += k.alpha_c0 * mu_ab * 0.5f * (inv[c] + b.inv);
+      }
+      radial *= F;
+      if constexpr (Viscous) {
+        const B viscous = k.two_mu * inv_rr * F;
+        ax[0][c] += radial * dx + viscous * (w[0][c] - b.wx);
+        ax[1][c] += radial * dy + viscous * (w[1][c] - b.wy);
+        if constexpr (D == 3) ax[D - 1][c] += radial * dz + viscous * (w[D - 1][c] - b.wz);
+      } else {
+        ax[0][c] += radial * dx;
+        ax[1][c] += radial * dy;
+        if constexpr (D == 3) ax[D - 1][c] += radial * dz;
+      }
+      B g_dot_rba = -(k.gravity[0] * dx + k.gravity[1] * dy);
+      if constexpr (D == 3) g_dot_rba -= k.gravity[D - 1] * dz;
+      diff[c] += b.fluid * (b.ex - ex[c] - k.hydrostatic * g_dot_rba) * (-F) * b.inv;
+      if constexpr (WithKernelSum) {
+        csum[c] += kernel_value(W, r) * b.inv;
+        cg[0][c] += F * dx * b.inv;
+        cg[1][c] += F * dy * b.inv;
+        if constexpr (D == 3) cg[D - 1][c] += F * dz * b.inv;
+      }
+    }
+  }
+  for (int c = 0; c < C; ++c) {
+    const int o = c * S;
+    for (int d = 0; d < D; ++d) {
+      ax[d][c].store_aligned(&acc[d][o]);
+      if constexpr (WithKernelSum) cg[d][c].store_aligned(&L.cg[d][o]);
+    }
+    cont[c].store_aligned(&L.cont[o]);
+    diff[c].store_aligned(&L.diff[o]);
+    if constexpr (WithKernelSum) csum[c].store_aligned(&L.csum[o]);
+  }
+}
+
+// sweep_neighbours with C = the number of vectors the block's n lanes fill (1 .. kBlock/kBatch).
+template <int D, bool AV, bool KS, bool Viscous, int C = kBlock / kBatch, class Kernel>
+inline void sweep_lanes(int n, LaneBlock& L, const Neighbour* list, std::size_t count, float (*acc)[kBlock],
+                        const PairConstants<D>& k, const Kernel& W) {
+  if constexpr (C > 1) {
+    if (n <= (C - 1) * kBatch) return sweep_lanes<D, AV, KS, Viscous, C - 1>(n, L, list, count, acc, k, W);
+  }
+  sweep_neighbours<D, AV, KS, Viscous, C>(L, list, count, acc, k, W);
+}
+
 // Bounding box of a block's lanes. A neighbour farther than a support from it meets no lane,
 // and the box test is far cheaper than the SIMD pass over the lanes: it drops about half of
 // the candidates of the neighbour cells in 3D.
 template <int D>
-inline void lane_box(const float (&x)[3][kBlock], int n, float* lo, float* hi) {
+[[gnu::always_inline]] inline void lane_box(const float (&x)[3][kBlock], int n, float* lo, float* hi) {
   for (int d = 0; d < D; ++d) {
     lo[d] = hi[d] = x[d][0];
     for (int i = 1; i < n; ++i) {
@@ -243,7 +394,7 @@ inline void lane_box(const float (&x)[3][kBlock], int n, float* lo, float* hi) {
   }
 }
 template <int D>
-inline bool near_box(const float* lo, const float* hi, float x, float y, float z, float support2) {
+[[gnu::always_inline]] inline bool near_box(const float* lo, const float* hi, float x, float y, float z, float support2) {
   const float q[3] = {x, y, z};
   float outside2 = 0.0f;
   for (int d = 0; d < D; ++d) {
@@ -274,16 +425,19 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
 [[gnu::noinline]] void cell_block_rates(Particles<D>& particles, const ParticleView<D>& p, const PairConstants<D>& k, const Kernel& W,
                       const std::uint32_t* lane_index, int n,
                       const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments, int segment_count,
-                      const PairFilter<D>& filter, LaneBlock& L, const BodyBooking<D>& booking) {
+                      const PairFilter<D>& filter, LaneBlock& L, NeighbourLists& lists, const BodyBooking<D>& booking) {
   {
     const int padded = (n + kLanes - 1) / kLanes * kLanes;
+    // Lanes loaded: the masked path's vectors of kLanes and the register path's of kBatch.
+    constexpr int kLoadMultiple = std::max(kLanes, kBatch);
+    const int loaded = (n + kLoadMultiple - 1) / kLoadMultiple * kLoadMultiple;
     bool block_near = false;
     if constexpr (Masked) {
       for (int i = 0; i < kBlock; ++i) L.keep[i] = 1.0f;
       for (int i = 0; i < n; ++i) block_near = block_near || filter.is_near(lane_index[i]);
     }
     bool keep_dirty = false;
-    for (int i = 0; i < padded; ++i) {
+    for (int i = 0; i < loaded; ++i) {
       const bool real = i < n;
       const std::uint32_t a = lane_index[real ? i : 0];
       for (int d = 0; d < 3; ++d) {
@@ -303,6 +457,57 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
     unsigned booked_bodies = 0;  // bit k: body k got a pair this block
     float box_lo[3] = {0, 0, 0}, box_hi[3] = {0, 0, 0};
     lane_box<D>(L.x, n, box_lo, box_hi);
+    if constexpr (!Masked) {
+      // Register path: collect the neighbours that pass the box test, then sweep each list
+      // once over all lanes. Per lane the terms are summed in neighbour order, plain ones
+      // first, then each booked body's, whatever the block: the sums do not depend on how
+      // the lanes were blocked (1 or 2 MPI ranks agree bit for bit).
+      std::size_t candidates = 0;
+      for (int sidx = 0; sidx < segment_count; ++sidx) candidates += segments[sidx].end - segments[sidx].begin;
+      lists.make_room(candidates, Bodies);
+      Neighbour* plain = lists.plain.data();
+      std::size_t plain_count = 0;
+      for (int sidx = 0; sidx < segment_count; ++sidx) {
+        const auto& seg = segments[sidx];
+        float shift[3] = {0, 0, 0};
+        for (int d = 0; d < D; ++d) shift[d] = static_cast<float>(seg.shift[d]);
+        for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
+          const float nb_x[3] = {p.x[0][b] + shift[0], p.x[1][b] + shift[1], D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f};
+          if (!near_box<D>(box_lo, box_hi, nb_x[0], nb_x[1], nb_x[2], k.support2)) continue;
+          const Neighbour nb{nb_x[0], nb_x[1], nb_x[2],
+                             p.v[0][b], p.v[1][b], D == 3 ? p.v[D - 1][b] : 0.0f,
+                             p.vv[0][b], p.vv[1][b], D == 3 ? p.vv[D - 1][b] : 0.0f,
+                             p.pressure[b], p.inverse_density[b], p.excess[b], p.fluid[b]};
+          if constexpr (Bodies) {
+            if (booking.books(particles, b)) {
+              const unsigned body = particles.body[b];
+              if (!(booked_bodies & (1u << body))) {
+                lists.booked_count[body] = 0;
+                booked_bodies |= 1u << body;
+              }
+              lists.booked[body][lists.booked_count[body]++] = nb;
+              continue;
+            }
+          }
+          plain[plain_count++] = nb;
+        }
+      }
+      auto sweep = [&](const Neighbour* list, std::size_t count, float (*acc)[kBlock]) {
+        if (k.two_mu != 0.0f) sweep_lanes<D, WithArtificialViscosity, WithKernelSum, true>(n, L, list, count, acc, k, W);
+        else sweep_lanes<D, WithArtificialViscosity, WithKernelSum, false>(n, L, list, count, acc, k, W);
+      };
+      sweep(plain, plain_count, L.acc);
+      if constexpr (Bodies) {
+        for (unsigned body = 0; booked_bodies >> body; ++body) {
+          if (!(booked_bodies & (1u << body))) continue;
+          for (int d = 0; d < 3; ++d)
+            for (int i = 0; i < kBlock; ++i) L.booked[body][d][i] = 0.0f;
+          sweep(lists.booked[body].data(), lists.booked_count[body], L.booked[body]);
+          for (int d = 0; d < D; ++d)
+            for (int i = 0; i < n; ++i) L.acc[d][i] += L.booked[body][d][i];
+        }
+      }
+    } else {
     for (int sidx = 0; sidx < segment_count; ++sidx) {
       const auto& seg = segments[sidx];
       float shift[3] = {0, 0, 0};
@@ -343,6 +548,7 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
         add_neighbour<D, WithArtificialViscosity, WithKernelSum, Masked, false>(L, nb, padded, k, W, nullptr);
       }
     }
+    }
     for (int i = 0; i < n; ++i) {
       const std::uint32_t a = lane_index[i];
       if (particles.kind[a] != Kind::fluid) continue;
@@ -359,7 +565,8 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
         if (!(booked_bodies & (1u << body))) continue;
         for (int d = 0; d < D; ++d) {
           float sum = 0.0f;
-          for (int i = 0; i < n; ++i) sum += L.booked[body][d][i];
+          // (The masked path's bookings are already times the lane's fluid flag, 0 or 1.)
+          for (int i = 0; i < n; ++i) sum += L.fluid[i] * L.booked[body][d][i];
           booking.thread_forces[body * D + d] -= static_cast<double>(k.mass) * k.mass * sum;
         }
       }
@@ -373,6 +580,63 @@ struct alignas(64) WallLanes {
   alignas(64) float sum_w[kBlock], sum_p[kBlock], sum_rho_r[3][kBlock], sum_v[3][kBlock];
 };
 
+// A fluid neighbour of a wall block, as broadcast to the lanes.
+struct WallNeighbour {
+  float x, y, z, rho, p, vx, vy, vz;
+};
+
+// The wall state's sums for a whole list of fluid neighbours, the lanes' sums in registers
+// (C vectors of lanes) for the length of the list, as sweep_neighbours does for the rates.
+template <int D, int C, class Kernel>
+inline void sweep_wall_neighbours(WallLanes& L, const WallNeighbour* nb, std::size_t count, const Kernel& W) {
+  using B = LaneBatch;
+  constexpr int S = kBatch;
+  B x[3][C], sum_w[C], sum_p[C], sum_rho_r[3][C], sum_v[3][C];
+  for (int c = 0; c < C; ++c) {
+    for (int d = 0; d < D; ++d) {
+      x[d][c] = B::load_aligned(&L.x[d][c * S]);
+      sum_rho_r[d][c] = sum_v[d][c] = B(0.0f);
+    }
+    sum_w[c] = sum_p[c] = B(0.0f);
+  }
+  for (std::size_t j = 0; j < count; ++j) {
+    const WallNeighbour& b = nb[j];
+    for (int c = 0; c < C; ++c) {
+      const B dx = x[0][c] - b.x, dy = x[1][c] - b.y;
+      const B dz = D == 3 ? x[D - 1][c] - b.z : B(0.0f);
+      B r2 = dx * dx + dy * dy;
+      if constexpr (D == 3) r2 += dz * dz;
+      const B wk = kernel_value(W, xsimd::sqrt(r2));
+      sum_w[c] += wk;
+      sum_p[c] += b.p * wk;
+      const B rho_w = b.rho * wk;
+      sum_rho_r[0][c] += rho_w * dx;
+      sum_rho_r[1][c] += rho_w * dy;
+      if constexpr (D == 3) sum_rho_r[D - 1][c] += rho_w * dz;
+      sum_v[0][c] += b.vx * wk;
+      sum_v[1][c] += b.vy * wk;
+      if constexpr (D == 3) sum_v[D - 1][c] += b.vz * wk;
+    }
+  }
+  for (int c = 0; c < C; ++c) {
+    const int o = c * S;
+    sum_w[c].store_aligned(&L.sum_w[o]);
+    sum_p[c].store_aligned(&L.sum_p[o]);
+    for (int d = 0; d < D; ++d) {
+      sum_rho_r[d][c].store_aligned(&L.sum_rho_r[d][o]);
+      sum_v[d][c].store_aligned(&L.sum_v[d][o]);
+    }
+  }
+}
+
+template <int D, int C = kBlock / kBatch, class Kernel>
+inline void sweep_wall_lanes(int n, WallLanes& L, const WallNeighbour* list, std::size_t count, const Kernel& W) {
+  if constexpr (C > 1) {
+    if (n <= (C - 1) * kBatch) return sweep_wall_lanes<D, C - 1>(n, L, list, count, W);
+  }
+  sweep_wall_neighbours<D, C>(L, list, count, W);
+}
+
 // Sums over the fluid neighbours of every wall lane of one cell (SIMD over the lanes, each
 // fluid neighbour broadcast, as in cell_block_rates), then sets the lanes' wall state.
 template <int D, bool Masked, class Kernel>
@@ -380,10 +644,12 @@ template <int D, bool Masked, class Kernel>
                                              const LinearMieGruneisen& eos, const Kernel& W, const std::uint32_t* lane_index,
                                              int n, const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments,
                                              int segment_count, const PairFilter<D>& filter,
-                                             const std::vector<Vec<D>>& body_acceleration, float support2, WallLanes& L) {
+                                             const std::vector<Vec<D>>& body_acceleration, float support2, WallLanes& L,
+                                             std::vector<WallNeighbour>& list) {
   const float rho0 = static_cast<float>(s.rest_density);
   {
-    const int padded = (n + kLanes - 1) / kLanes * kLanes;
+    constexpr int kLoadMultiple = std::max(kLanes, kBatch);
+    const int padded = (n + kLoadMultiple - 1) / kLoadMultiple * kLoadMultiple;
     bool block_near = false;
     if constexpr (Masked) {
       for (int i = 0; i < kBlock; ++i) L.keep[i] = 1.0f;
@@ -403,6 +669,9 @@ template <int D, bool Masked, class Kernel>
     }
     float box_lo[3] = {0, 0, 0}, box_hi[3] = {0, 0, 0};
     lane_box<D>(L.x, n, box_lo, box_hi);
+    std::size_t candidates = 0, listed = 0;
+    for (int sidx = 0; sidx < segment_count; ++sidx) candidates += segments[sidx].end - segments[sidx].begin;
+    if (list.size() < candidates) list.resize(candidates);
     for (int sidx = 0; sidx < segment_count; ++sidx) {
       const auto& seg = segments[sidx];
       float shift[3] = {0, 0, 0};
@@ -415,6 +684,10 @@ template <int D, bool Masked, class Kernel>
         if (any_wall && p.kind[b] == Kind::mirror_fluid) __atomic_store_n(&particles.near_wall[b], std::uint8_t{1}, __ATOMIC_RELAXED);
         const float rho_b = rho0 + p.excess[b], p_b = p.pressure[b];
         const float vxb = p.v[0][b], vyb = p.v[1][b], vzb = D == 3 ? p.v[D - 1][b] : 0.0f;
+        if constexpr (!Masked) {
+          list[listed++] = {xb, yb, zb, rho_b, p_b, vxb, vyb, vzb};
+          continue;
+        }
         if constexpr (Masked) {
           if (block_near || filter.is_near(b)) {
             for (int i = 0; i < n; ++i) {
@@ -444,6 +717,7 @@ template <int D, bool Masked, class Kernel>
         }
       }
     }
+    if constexpr (!Masked) sweep_wall_lanes<D>(n, L, list.data(), listed, W);
     for (int i = 0; i < n; ++i) {
       const std::uint32_t w = lane_index[i];
       if (particles.kind[w] != Kind::wall && particles.kind[w] != Kind::mirror_wall) continue;
@@ -506,13 +780,14 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
 #pragma omp parallel
     {
       WallLanes lanes;
+      std::vector<WallNeighbour> list;
       for_each_lane_block<D, kBlock>(
           grid, [&](std::uint32_t a) { return p.kind[a] == Kind::wall || p.kind[a] == Kind::mirror_wall; },
           [&](const std::uint32_t* lane_index, int n, const auto& segments, int count) {
             if (filter.touches(segments, count))
-              cell_block_wall_state<D, true>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, lanes);
+              cell_block_wall_state<D, true>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, lanes, list);
             else
-              cell_block_wall_state<D, false>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, lanes);
+              cell_block_wall_state<D, false>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, lanes, list);
           });
     }
   });
@@ -545,6 +820,7 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
 #pragma omp parallel
     {
       LaneBlock lanes;
+      NeighbourLists lists;
       BodyBooking<D> booking;
       booking.body_count = body_count;
       booking.include_fixed = include_fixed_walls;
@@ -558,11 +834,11 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
         const bool masked = filter.touches(segments, count);
         auto run = [&]<bool AV, bool KS>() {
           if (body_count > 0) {
-            if (masked) cell_block_rates<D, AV, KS, true, true>(p, view, k, W, lane_index, n, segments, count, filter, lanes, booking);
-            else cell_block_rates<D, AV, KS, false, true>(p, view, k, W, lane_index, n, segments, count, filter, lanes, booking);
+            if (masked) cell_block_rates<D, AV, KS, true, true>(p, view, k, W, lane_index, n, segments, count, filter, lanes, lists, booking);
+            else cell_block_rates<D, AV, KS, false, true>(p, view, k, W, lane_index, n, segments, count, filter, lanes, lists, booking);
           } else {
-            if (masked) cell_block_rates<D, AV, KS, true, false>(p, view, k, W, lane_index, n, segments, count, filter, lanes, booking);
-            else cell_block_rates<D, AV, KS, false, false>(p, view, k, W, lane_index, n, segments, count, filter, lanes, booking);
+            if (masked) cell_block_rates<D, AV, KS, true, false>(p, view, k, W, lane_index, n, segments, count, filter, lanes, lists, booking);
+            else cell_block_rates<D, AV, KS, false, false>(p, view, k, W, lane_index, n, segments, count, filter, lanes, lists, booking);
           }
         };
         if (k.alpha_c0 > 0) {

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <omp.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
@@ -79,11 +80,58 @@ void TwoSidedWall::classify(const Particles<2>& p) {
     // (the side test alone would call that a leak when the end of the step is no longer
     // beyond the tip).
     if (remembered != 0 && remembered != side && !nw.closest.at_free_end && !corrected_by_id_[id] &&
-        (id >= previous_by_id_.size() || crosses(wall_, previous_by_id_[id], x)))
+        (id >= previous_by_id_.size() || crosses(wall_, previous_by_id_[id], x))) {
       ++leaks;
+#pragma omp critical(thin_wall_leak_log)
+      log_leak(id, remembered, x, nw.closest);
+    }
     remembered = side;
   }
   counters_.leaks += leaks;
+}
+
+void TwoSidedWall::log_leak(std::uint32_t id, int remembered, const Vec2& x, const ClosestPoint& c) const {
+  // A leak is rare and stops the run soon: say where and how it crossed, so that the cause can
+  // be found (docs/fsi-2d.md, session 7: the leak near the folding root).
+  const Vec2 x0 = id < previous_by_id_.size() ? previous_by_id_[id] : x;
+  const auto straight = first_crossing(wall_, x0, x);
+  std::string swept = "no begin_step";
+  if (start_nodes_.size() == wall_.position.size()) {
+    const auto s = swept_crossing(start_nodes_, wall_.position, x0, x);
+    swept = s ? fmt::format("odd, first on segment {} at tau {:.3f}", s->segment, s->tau) : "even (0 or 2 events)";
+  }
+  // The bend at the crossed segment's ends: the angle between neighbouring segments' tangents.
+  const std::size_t k = straight ? straight->segment : c.segment;
+  auto bend = [&](std::size_t a) {
+    if (a == 0 || a >= wall_.segment_count()) return 0.0;
+    const Vec2 t0 = wall_.tangent(a - 1), t1 = wall_.tangent(a);
+    return std::atan2(t0[0] * t1[1] - t0[1] * t1[0], dot(t0, t1)) * 180.0 / 3.141592653589793;
+  };
+  const Vec2 moved = start_nodes_.size() == wall_.position.size()
+                         ? Vec2{wall_.position[k][0] - start_nodes_[k][0], wall_.position[k][1] - start_nodes_[k][1]}
+                         : Vec2{0.0, 0.0};
+  // A leaflet that passes through itself (the solid has no self-contact) has no consistent sides.
+  std::string self = "none";
+  double nearest = 1e300;
+  for (std::size_t i = 0; i + 2 < wall_.segment_count(); ++i)
+    for (std::size_t j = i + 2; j < wall_.segment_count(); ++j) {
+      const auto hit = first_crossing(wall_, std::vector<std::uint32_t>{static_cast<std::uint32_t>(j)}, wall_.position[i],
+                                      wall_.position[i + 1]);
+      if (!hit) continue;
+      const Vec2 q = wall_.point(j, hit->t);
+      const double d = std::hypot(q[0] - x[0], q[1] - x[1]);
+      if (d < nearest) {
+        nearest = d;
+        self = fmt::format("segments {} and {} cross at ({:.4f}, {:.4f}) mm, {:.4f} mm from the particle", i, j, 1e3 * q[0],
+                           1e3 * q[1], 1e3 * d);
+      }
+    }
+  spdlog::warn(
+      "thin wall: leak of particle id {} from side {} to {}: step ({:.4f}, {:.4f}) -> ({:.4f}, {:.4f}) mm crosses the end wall's "
+      "segment {} (straight test {}), swept test {}; closest segment {} t {:.3f} at {:.4f} mm; bends at the segment's ends "
+      "{:.1f} / {:.1f} deg; its start node moved ({:.4f}, {:.4f}) mm in the step; {} segments; self-crossing of the wall: {}",
+      id, remembered, c.side, 1e3 * x0[0], 1e3 * x0[1], 1e3 * x[0], 1e3 * x[1], k, straight ? "yes" : "no", swept, c.segment, c.t,
+      1e3 * c.distance, bend(k), bend(k + 1), 1e3 * moved[0], 1e3 * moved[1], wall_.segment_count(), self);
 }
 
 bool TwoSidedWall::blocked(std::uint32_t a, std::uint32_t b, const Particles<2>& p) const {

@@ -119,6 +119,9 @@ class TwoSidedWall {
   float virtual_kernel_sum(std::size_t i) const { return i < virtual_kernel_sum_.size() ? virtual_kernel_sum_[i] : 0.0f; }
 
  private:
+  // Logs one leak found by classify (where, across which segment, what the swept test said).
+  void log_leak(std::uint32_t id, int remembered, const Vec2& x, const ClosestPoint& c) const;
+
   Polyline wall_;
   MarkerSet markers_;
   FluidSettings<2> fluid_;

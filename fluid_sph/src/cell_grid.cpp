@@ -116,7 +116,7 @@ void CellGrid<D>::sort(Particles<D>& p) {
     for (std::size_t i = lo; i < hi; ++i) order_[counts[cell_index_[i]]++] = static_cast<std::uint32_t>(i);
   }
 
-  p.for_each_array_with(sorted_, [n](auto&, auto& target) { target.resize(n); });
+  p.for_each_sorted_array_with(sorted_, [n](auto&, auto& target) { target.resize(n); });
   for (int d = 0; d < D; ++d) p.local_position[d].resize(n);
   p.fluid_mask.resize(n);
   p.inverse_density.resize(n);
@@ -125,7 +125,7 @@ void CellGrid<D>::sort(Particles<D>& p) {
   // One parallel region for all arrays: the gathers share no barrier until the end.
 #pragma omp parallel
   {
-    p.for_each_array_with(sorted_, [this, n](auto& source, auto& target) {
+    p.for_each_sorted_array_with(sorted_, [this, n](auto& source, auto& target) {
 #pragma omp for schedule(static) nowait
       for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) target[i] = source[order_[i]];
     });
@@ -133,10 +133,14 @@ void CellGrid<D>::sort(Particles<D>& p) {
 #pragma omp for schedule(static)
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
       for (int d = 0; d < D; ++d) p.local_position[d][i] = static_cast<float>(sorted_.position[d][i] - lower_[d]);
-      p.fluid_mask[i] = acts_as_fluid(sorted_.kind[i]) ? 1.0f : 0.0f;
+      const bool fluid = acts_as_fluid(sorted_.kind[i]);
+      p.fluid_mask[i] = fluid ? 1.0f : 0.0f;
+      // Not carried along (for_each_sorted_array_with): a fluid particle's is its velocity.
+      if (fluid)
+        for (int d = 0; d < D; ++d) p.viscous_velocity[d][i] = sorted_.velocity[d][i];
     }
   }
-  p.for_each_array_with(sorted_, [](auto& a, auto& b) { a.swap(b); });
+  p.for_each_sorted_array_with(sorted_, [](auto& a, auto& b) { a.swap(b); });
 }
 
 template <int D>

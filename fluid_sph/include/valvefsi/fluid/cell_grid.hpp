@@ -37,7 +37,9 @@ class CellGrid {
   // non-periodic axis (or not finite) as Kind::lost. Returns how many became lost now.
   std::size_t wrap_and_mark_lost(Particles<D>& particles) const;
 
-  // Stable counting sort of all particle arrays by cell; lost particles go to the end.
+  // Stable counting sort of the particle arrays a sort carries (Particles::for_each_sorted_array_with)
+  // by cell; lost particles go to the end. Sets the pair loops' scratch and, for fluid, the
+  // viscous velocity (= velocity).
   void sort(Particles<D>& particles);
 
   // First particle of cell c; cell_start(cell_count()) is the first lost particle.

@@ -110,6 +110,23 @@ struct Particles {
     f(id, other.id);
   }
 
+  // The same for the arrays a re-sort must carry along: all but the acceleration, the
+  // density rate and the viscous velocity, which every rate evaluation rebuilds before they
+  // are read (fluid: viscous velocity = velocity, set after the sort; walls: the wall state).
+  template <class F>
+  void for_each_sorted_array_with(Particles& other, F&& f) {
+    for (int d = 0; d < D; ++d) {
+      f(position[d], other.position[d]);
+      f(velocity[d], other.velocity[d]);
+    }
+    f(density_excess, other.density_excess);
+    f(density_rate_previous, other.density_rate_previous);
+    f(pressure, other.pressure);
+    f(kind, other.kind);
+    f(body, other.body);
+    f(id, other.id);
+  }
+
   std::size_t count(Kind k) const {
     std::size_t n = 0;
     for (Kind x : kind) n += (x == k);

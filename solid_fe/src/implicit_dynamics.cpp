@@ -5,10 +5,7 @@
 // when Newton converges fast and is cut and retried when it does not. Same fixed nodes, mirror
 // planes, contact and follower pressure as the explicit path, which it replaces step for step.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -33,6 +30,11 @@ struct ExplicitSolver::ImplicitWork {
   Eigen::SparseMatrix<double> matrix;
   Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
   Eigen::Index analysed_nonzeros = -1;  // pattern of the last analysis (constant in practice)
+  // Modified Newton: the factorised tangent is kept across iterations and steps while the step
+  // size is the one it was built for and the residual falls fast enough with it.
+  bool factor_valid = false;
+  double factor_step = 0;
+  int fast_steps = 0;  // consecutive steps converged within newton_fast_iterations
   Eigen::Matrix3Xd dx, a, v, r, net, net_n;
   Eigen::VectorXd delta;
 };
@@ -114,6 +116,7 @@ bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_force
   const Eigen::Matrix3Xd& reference = elements_->reference_positions();
   const double round_off = 1e-12 * (reference.rowwise().maxCoeff() - reference.rowwise().minCoeff()).norm();
   double correction = std::numeric_limits<double>::infinity();
+  double previous_residual = std::numeric_limits<double>::infinity();
   for (int iteration = 0;; ++iteration) {
     state_.position = x_n + w.dx;
     state_.time = t_new;
@@ -139,23 +142,46 @@ bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_force
                                    state_.contact_force.norm(), w.net_n.norm(), 1e-300});
     residual = w.r.norm() / scale;
     if (!std::isfinite(residual)) return fail();
-    if (std::getenv("VALVEFSI_NEWTON_DEBUG") != nullptr) {
-      std::fprintf(stderr, "t %.6g h %.3g it %d residual %.3g scale %.3g\n", t_new, h, iteration, residual, scale);
-    }
     w.r.colwise().norm().maxCoeff(&worst_node);
     if (residual <= options_.newton_tolerance || correction <= round_off) {
       state_.newton_iterations = iteration;
       break;
     }
-    if (iteration >= options_.newton_max_iterations) return fail();
+    if (iteration >= options_.newton_max_iterations) {
+      w.factor_valid = false;  // the retry starts from a fresh tangent
+      return fail();
+    }
+    // A kept tangent is refreshed when it was built for another step size or when the residual
+    // fell by less than 4x in the last iteration with it.
+    const bool refresh = !w.factor_valid || std::abs(w.factor_step - h) > 1e-9 * h ||
+                         (iteration > 0 && residual > 0.25 * previous_residual);
+    previous_residual = residual;
+    if (refresh && !factorise_tangent(h, t_new, mass_coefficient, stiffness_coefficient)) return fail();
+    w.delta = w.lu.solve(-Eigen::Map<const Eigen::VectorXd>(w.r.data(), 3 * n));
+    if (w.lu.info() != Eigen::Success || !w.delta.allFinite()) {
+      w.factor_valid = false;
+      return fail();
+    }
+    w.r = Eigen::Map<const Eigen::Matrix3Xd>(w.delta.data(), 3, n);
+    apply_constraints(w.r);
+    w.dx += w.r;
+    correction = w.r.cwiseAbs().maxCoeff();
+  }
+  return finish_implicit_step(start, h);
+}
 
+bool ExplicitSolver::factorise_tangent(double h, double t_new, double mass_coefficient, double stiffness_coefficient) {
+  ImplicitWork& w = *implicit_;
+  const Eigen::ArrayXd mass = elements_->nodal_mass().array();
+  const Eigen::Index n = state_.position.cols();
+  w.factor_valid = false;
+  {
     // Tangent: mass_coefficient M + (1 - alpha_f) (K_int - K_pressure + K_contact), constrained
     // rows and columns projected, their diagonal kept at the mass term so the matrix stays regular.
-    const auto clock0 = std::chrono::steady_clock::now();
     try {
       elements_->internal_force_tangent(state_.position, w.blocks);
     } catch (const MaterialStateError&) {
-      return fail();
+      return false;
     }
     const std::size_t internal_blocks = w.blocks.size();
     if (pressure_) elements_->add_pressure_tangent(state_.position, pressure_(t_new), w.blocks);
@@ -186,30 +212,26 @@ bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_force
       add_block(node, node, Eigen::Matrix3d::Zero());  // keeps the pattern whether in contact or not
       for (int d = 0; d < 3; ++d) w.triplets.emplace_back(3 * node + d, 3 * node + d, mass_coefficient * mass(i));
     }
-    const auto clock1 = std::chrono::steady_clock::now();
     w.matrix.resize(3 * n, 3 * n);
     w.matrix.setFromTriplets(w.triplets.begin(), w.triplets.end());
     if (w.matrix.nonZeros() != w.analysed_nonzeros) {
       w.lu.analyzePattern(w.matrix);
       w.analysed_nonzeros = w.matrix.nonZeros();
     }
-    const auto clock2 = std::chrono::steady_clock::now();
     w.lu.factorize(w.matrix);
-    if (w.lu.info() != Eigen::Success) return fail();
-    w.delta = w.lu.solve(-Eigen::Map<const Eigen::VectorXd>(w.r.data(), 3 * n));
-    if (w.lu.info() != Eigen::Success || !w.delta.allFinite()) return fail();
-    w.r = Eigen::Map<const Eigen::Matrix3Xd>(w.delta.data(), 3, n);
-    apply_constraints(w.r);
-    w.dx += w.r;
-    correction = w.r.cwiseAbs().maxCoeff();
-    if (std::getenv("VALVEFSI_NEWTON_DEBUG") != nullptr) {
-      const auto clock3 = std::chrono::steady_clock::now();
-      std::fprintf(stderr, "timing tangent %.3g ms assemble %.3g ms factor+solve %.3g ms nnz %ld\n",
-                   std::chrono::duration<double, std::milli>(clock1 - clock0).count(),
-                   std::chrono::duration<double, std::milli>(clock2 - clock1).count(),
-                   std::chrono::duration<double, std::milli>(clock3 - clock2).count(), static_cast<long>(w.matrix.nonZeros()));
-    }
+    if (w.lu.info() != Eigen::Success) return false;
   }
+  w.factor_valid = true;
+  w.factor_step = h;
+  return true;
+}
+
+bool ExplicitSolver::finish_implicit_step(const SolverState& start, double h) {
+  ImplicitWork& w = *implicit_;
+  const Eigen::ArrayXd mass = elements_->nodal_mass().array();
+  const double damping = options_.mass_damping_per_s;
+  const Eigen::Matrix3Xd& v_n = start.velocity;
+  const Eigen::Index n = v_n.cols();
 
   // Converged: the state at t_new, and the step's booking (trapezoidal works as the explicit
   // ledger; what the net force's work did not put into kinetic energy is the scheme's dissipation).
@@ -247,7 +269,11 @@ void ExplicitSolver::advance_window_implicit(double t_end, const Eigen::Matrix3X
     state_.acceleration = acceleration_ - options_.mass_damping_per_s * state_.velocity;
     apply_constraints(state_.acceleration);
   }
-  double h = state_.implicit_step > 0.0 ? state_.implicit_step : options_.implicit_initial_step;
+  // Steps are max_time_step / 2^k, so that they divide output windows of that size and a kept
+  // tangent (built for one step size) serves many steps.
+  double h = options_.max_time_step;
+  const double first = state_.implicit_step > 0.0 ? state_.implicit_step : options_.implicit_initial_step;
+  while (h > first * (1.0 + 1e-9)) h *= 0.5;
   while (state_.time < t_end) {
     h = std::min(h, options_.max_time_step);
     const double remaining = t_end - state_.time;
@@ -265,10 +291,16 @@ void ExplicitSolver::advance_window_implicit(double t_end, const Eigen::Matrix3X
       if (lands) state_.time = t_end;
       // Grow after fast convergence, shrink after slow; a step cut to land on the window's end
       // does not set the next one.
+      ImplicitWork& w = *implicit_;
       if (state_.newton_iterations <= options_.newton_fast_iterations) {
-        h = std::max(h, step) * 1.25;
-      } else if (state_.newton_iterations >= options_.newton_max_iterations - 2) {
-        h = step * 0.7;
+        // Doubling rebuilds the tangent: only after a run of fast steps.
+        if (!lands && ++w.fast_steps >= 2) {
+          h *= 2.0;
+          w.fast_steps = 0;
+        }
+      } else {
+        w.fast_steps = 0;
+        if (state_.newton_iterations >= options_.newton_max_iterations - 2) h *= 0.5;
       }
       state_.implicit_step = h;
       state_.stable_step = h;
@@ -279,7 +311,8 @@ void ExplicitSolver::advance_window_implicit(double t_end, const Eigen::Matrix3X
       if (options_.max_energy_balance_error > 0.0 && state_.step >= kEnergyCheckFirstStep) check_energy_growth();
       continue;
     }
-    h = 0.25 * step;
+    implicit_->fast_steps = 0;
+    h = 0.25 * h;
     if (h < options_.implicit_min_step) {
       const Eigen::Vector3d xw = worst >= 0 ? Eigen::Vector3d(state_.position.col(worst)) : Eigen::Vector3d::Zero();
       throw NewtonFailureError(fmt::format(

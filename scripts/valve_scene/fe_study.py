@@ -400,7 +400,9 @@ def main(argv=None) -> None:
                 results[-1].label = f"{spec.name} (windows, {results[-1].mesh_label})"
                 opening_dirs.append(dirs[0])
                 if args.cycle_runs_dir and (args.cycle_runs_dir / spec.name).exists():
-                    results.append(analyse(spec, args.cycle_runs_dir / spec.name, cycle=args.cycle))
+                    cycle_wall, cycle_cpu = recorded_times([args.cycle_runs_dir / spec.name])
+                    results.append(analyse(spec, args.cycle_runs_dir / spec.name, cycle=args.cycle, wall_time_s=cycle_wall))
+                    results[-1].cpu_time_s = cycle_cpu
                     results[-1].label = f"{spec.name} (cycle {args.cycle}, {results[-1].mesh_label})"
             else:
                 if not args.skip_run:

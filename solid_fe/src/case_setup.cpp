@@ -104,6 +104,10 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   const std::string mesh_name = setup.mesh_file.string();
   const bool bricks = solid.element_family() == cases::SolidCase::HEXAHEDRON;
   setup.element_family = bricks ? ElementFamily::hexahedron : ElementFamily::shell;
+  if (bricks && solid.time_integration() == cases::SolidCase::IMPLICIT) {
+    throw CaseError(fmt::format("{}: field 'solid.time_integration' = IMPLICIT with solid.element_family = "
+                                "HEXAHEDRON: allowed only for SHELL (no brick tangent yet)", source));
+  }
   if (!bricks && mesh.triangles.empty()) {
     throw CaseError(fmt::format("{}: solid.element_family = SHELL but {} has no /mesh/triangles", source, mesh_name));
   }
@@ -165,10 +169,6 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.fixed_time_step = solid.forced_time_step();
   solver_options.time_step_look_ahead = solid.time_step_look_ahead();
   if (solid.time_integration() == cases::SolidCase::IMPLICIT) {
-    if (solid.element_family() == cases::SolidCase::HEXAHEDRON) {
-      throw CaseError(fmt::format("{}: field 'solid.time_integration' = IMPLICIT with solid.element_family = "
-                                  "HEXAHEDRON: allowed only for SHELL (no brick tangent yet)", source));
-    }
     if (setup.dimension == 2) {
       throw CaseError(fmt::format("{}: field 'solid.time_integration' = IMPLICIT with run.dimension = 2: allowed "
                                   "only in 3D (2D strip ties are not in the implicit path)", source));

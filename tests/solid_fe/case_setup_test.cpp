@@ -50,6 +50,24 @@ TEST(CaseSetup, BuildsTheSolverFromTheCase) {
   EXPECT_EQ(fixed, 5);
 }
 
+TEST(CaseSetup, ImplicitTimeIntegrationIsReadAndRefusedForBricks) {
+  const CaseFiles f = write_case("implicit", "time_integration: IMPLICIT spectral_radius_infinity: 0.6");
+  const SolidSetup setup = setup_from_case(load_case(f.case_file), f.case_file);
+  const SolverOptions& o = setup.shell_solver().options();
+  EXPECT_TRUE(setup.shell_solver().implicit());
+  EXPECT_EQ(o.spectral_radius_infinity, 0.6);
+  EXPECT_EQ(o.newton_max_iterations, 10);  // the proto's default, filled by the loader
+  const CaseFiles bricks = write_case("implicit_bricks", "time_integration: IMPLICIT element_family: HEXAHEDRON");
+  try {
+    setup_from_case(load_case(bricks.case_file), bricks.case_file);
+    FAIL() << "bricks have no tangent: IMPLICIT must be refused";
+  } catch (const CaseError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("solid.time_integration"), std::string::npos) << what;
+    EXPECT_NE(what.find("SHELL"), std::string::npos) << "names what is allowed: " << what;
+  }
+}
+
 TEST(CaseSetup, UnknownNodeSetIsNamed) {
   const CaseFiles f = write_case("bad", "fixed_node_sets: \"nope\"");
   const cases::Case c = load_case(f.case_file);

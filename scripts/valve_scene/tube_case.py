@@ -40,13 +40,30 @@ SECTOR_FILL_LATTICE = "HEX_PRISM"     # the sector's fluid lattice (the full val
 # stable setting. c0 = 20 m/s (10x the waveform's Bernoulli jet speed, Mach <= 0.1), CFL 0.1,
 # particle shifting, no background pressure (each kernel defect next to a leaflet pushes the blood
 # with ~2 p_b grad(C)/rho: a sector at rest with p_b = 10.8 kPa reached 0.8 m/s, without it stays
-# still), plates that never pull, node loads smoothed over 3 dp, and a 13 us window (mu = 2 for
-# the 0.25 mm leaflet). At the old c0 = 145 m/s and 0.1 ms window (mu = 111) the coupled sector's
-# force grew x100-1000 per window and the solid stopped at 0.82 ms; with these it opened (46.8 ms).
+# still), plates that never pull, node loads smoothed over 3 dp, and a window of at most 13 us
+# (mu <= 2 for the 0.25 mm leaflet). At the old c0 = 145 m/s and 0.1 ms window (mu = 111) the
+# coupled sector's force grew x100-1000 per window and the solid stopped at 0.82 ms; with these it
+# opened (46.8 ms, session 6, 13 us window).
+BLOOD_DENSITY = 1056.0                # kg/m^3, blood
 FSI_3D_SOUND_SPEED = 20.0
 FSI_3D_CFL = 0.1
 FSI_3D_LOAD_SMOOTHING_RADIUS_RATIO = 3.0
-FSI_3D_COUPLING_WINDOW_S = 13.0e-6
+FSI_3D_MAX_COUPLING_WINDOW_S = 13.0e-6  # mu = 2: the explicit coupling's limit (docs/stability-map.md)
+FSI_3D_SMOOTHING_LENGTH_RATIO = 1.3     # the fluid's default h / dp
+# The fluid sub-cycles a window and shortens its last step to land on the window's end, so a 13 us
+# window over 5.85 us steps cost 3 steps (2 and a 1.3 us sliver: session 7's profile,
+# docs/fsi-3d.md). A window of two steps at 90 % of the step at rest costs 2 for as long as the
+# fastest particle is below c0 / 9 (2.2 m/s; dt = CFL h / (c0 + v)): 16 % fewer fluid steps, and a
+# lower mu (1.62 at 0.9 mm).
+FSI_3D_FLUID_STEPS_PER_WINDOW = 2
+FSI_3D_STEP_MARGIN = 0.9
+
+
+def fsi_3d_coupling_window_s(particle_spacing: float) -> float:
+    """The 3D FSI cases' coupling window for a fluid spacing: a whole number of fluid steps (with a
+    margin for the flow's speed), never above the mu = 2 limit."""
+    step_at_rest = FSI_3D_CFL * FSI_3D_SMOOTHING_LENGTH_RATIO * particle_spacing / FSI_3D_SOUND_SPEED
+    return min(FSI_3D_MAX_COUPLING_WINDOW_S, FSI_3D_FLUID_STEPS_PER_WINDOW * FSI_3D_STEP_MARGIN * step_at_rest)
 
 
 def _vec(values) -> str:
@@ -155,7 +172,7 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
         "fluid {",
         f"  particle_spacing: {dp:g}",
         "  kernel: CUBIC_SPLINE",
-        "  density: 1056",
+        f"  density: {BLOOD_DENSITY:g}",
         "  dynamic_viscosity: 0.0035",
         "  # the 2D valve's stable fluid (tube_case.FSI_3D_*, docs/thin-leaflet.md): c0 = 10x the jet",
         "  # speed, CFL 0.1 (the coupling window below sub-cycled), particle shifting",

@@ -159,12 +159,15 @@ def stent_cylinder_lines() -> str:
             f"  contact_cylinders {{ origin: [0, 0, 0] axis: [0, 0, 1] radius: {stent_radius():.6g} }}\n")
 
 
-def coupling_block() -> str:
-    from .tube_case import FSI_3D_COUPLING_WINDOW_S
+def coupling_block(particle_spacing: float) -> str:
+    from .tube_case import BLOOD_DENSITY, FSI_3D_SOUND_SPEED, fsi_3d_coupling_window_s
+    window = fsi_3d_coupling_window_s(particle_spacing)
+    mu = 2 * BLOOD_DENSITY * FSI_3D_SOUND_SPEED * window / (LEAFLET_DENSITY * ValveParameters().thickness)
     return ("coupling {\n"
             "  scheme: SERIAL_EXPLICIT\n"
-            "  # mu = 2 rho_f c0 dt / (rho_s t) = 2 for the 0.25 mm leaflet at c0 = 20 m/s (docs/thin-leaflet.md)\n"
-            f"  window_size: {FSI_3D_COUPLING_WINDOW_S:g}\n"
+            f"  # two fluid steps per window; mu = 2 rho_f c0 dt / (rho_s t) = {mu:.2f} for the 0.25 mm leaflet\n"
+            "  # at c0 = 20 m/s, below the explicit limit 2 (tube_case.fsi_3d_coupling_window_s, docs/fsi-3d.md)\n"
+            f"  window_size: {window:.4g}\n"
             "  mapping: NEAREST_PROJECTION\n"
             "}\n")
 
@@ -174,7 +177,7 @@ def case_text(spec: CaseSpec) -> str:
              f"({'FE-only' if spec.kind == 'FE' else 'SPH-FE FSI'})")
     parts = [header(spec), f"title: \"{title}\"\n", run_block(spec), waveform.waveform_textproto(), solid_block(spec)]
     if spec.kind == "FSI":
-        parts += [fluid_block(PARTICLE_SPACING[spec.resolution], CYCLES, sector=spec.variant == "sector"), coupling_block()]
+        parts += [fluid_block(PARTICLE_SPACING[spec.resolution], CYCLES, sector=spec.variant == "sector"), coupling_block(PARTICLE_SPACING[spec.resolution])]
     return "".join(parts)
 
 

@@ -66,6 +66,12 @@ TEST(SceneCaseFiles, LoadAndMatchTheirNames) {
                         (c.solid().density() * 0.25e-3);
       EXPECT_GT(mu, 0.0);
       EXPECT_LE(mu, 2.0 + 1e-9);
+      // a window of two fluid steps at rest (dt = CFL h / c0) with a margin for the flow's speed,
+      // so no window ends in a short third step (docs/fsi-3d.md, "Cost")
+      const double h_ratio = c.fluid().has_smoothing_length_ratio() ? c.fluid().smoothing_length_ratio() : 1.3;
+      const double step_at_rest = c.fluid().cfl() * h_ratio * c.fluid().particle_spacing() / c.fluid().sound_speed();
+      EXPECT_LE(c.coupling().window_size(), 2.0 * step_at_rest * (1.0 + 1e-9)) << name;
+      EXPECT_GT(c.coupling().window_size(), 1.5 * step_at_rest) << name;
       EXPECT_EQ(c.fluid().plates_size(), 2);
       // no step load at t = 0: the plates' offset cancels the waveform (gauge 0 = aortic pressure at opening)
       {

@@ -136,6 +136,7 @@ def solid_block(spec: CaseSpec) -> str:
 
 
 FE_ONLY_MASS_DAMPING_PER_S = 20.0   # docs/fe-only-study.md: two undamped cycles stop on energy growth at ~0.86 s
+FSI_3D_PEER_TIMEOUT_S = 120.0       # s; a crashed peer is still found at once (closed connection)
 FE_ONLY_RESTART_INTERVAL_S = 0.1    # long FE-only runs survive a stop (solid_fe --restart)
 
 
@@ -168,6 +169,9 @@ def coupling_block(particle_spacing: float) -> str:
             f"  # two fluid steps per window; mu = 2 rho_f c0 dt / (rho_s t) = {mu:.2f} for the 0.25 mm leaflet\n"
             "  # at c0 = 20 m/s, below the explicit limit 2 (tube_case.fsi_3d_coupling_window_s, docs/fsi-3d.md)\n"
             f"  window_size: {window:.4g}\n"
+            "  # a frozen peer is found after 2 min: the 10 s default stopped a live 3D run whose\n"
+            "  # heartbeats went unheard on a machine at load 21 (docs/fsi-3d.md, session 7)\n"
+            f"  peer_timeout_s: {FSI_3D_PEER_TIMEOUT_S:g}\n"
             "  mapping: NEAREST_PROJECTION\n"
             "}\n")
 

@@ -457,6 +457,23 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
     unsigned booked_bodies = 0;  // bit k: body k got a pair this block
     float box_lo[3] = {0, 0, 0}, box_hi[3] = {0, 0, 0};
     lane_box<D>(L.x, n, box_lo, box_hi);
+    // take(b, nb) for every particle of the segments (shifted across periodic sides) within a
+    // support of the lanes' box, in segment order: both paths below see the same neighbours.
+    auto for_each_candidate = [&](auto&& take) {
+      for (int sidx = 0; sidx < segment_count; ++sidx) {
+        const auto& seg = segments[sidx];
+        float shift[3] = {0, 0, 0};
+        for (int d = 0; d < D; ++d) shift[d] = static_cast<float>(seg.shift[d]);
+        for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
+          const float nb_x[3] = {p.x[0][b] + shift[0], p.x[1][b] + shift[1], D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f};
+          if (!near_box<D>(box_lo, box_hi, nb_x[0], nb_x[1], nb_x[2], k.support2)) continue;
+          take(b, Neighbour{nb_x[0], nb_x[1], nb_x[2],
+                            p.v[0][b], p.v[1][b], D == 3 ? p.v[D - 1][b] : 0.0f,
+                            p.vv[0][b], p.vv[1][b], D == 3 ? p.vv[D - 1][b] : 0.0f,
+                            p.pressure[b], p.inverse_density[b], p.excess[b], p.fluid[b]});
+        }
+      }
+    };
     if constexpr (!Masked) {
       // Register path: collect the neighbours that pass the box test, then sweep each list
       // once over all lanes. Per lane the terms are summed in neighbour order, plain ones
@@ -467,31 +484,20 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
       lists.make_room(candidates, Bodies);
       Neighbour* plain = lists.plain.data();
       std::size_t plain_count = 0;
-      for (int sidx = 0; sidx < segment_count; ++sidx) {
-        const auto& seg = segments[sidx];
-        float shift[3] = {0, 0, 0};
-        for (int d = 0; d < D; ++d) shift[d] = static_cast<float>(seg.shift[d]);
-        for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
-          const float nb_x[3] = {p.x[0][b] + shift[0], p.x[1][b] + shift[1], D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f};
-          if (!near_box<D>(box_lo, box_hi, nb_x[0], nb_x[1], nb_x[2], k.support2)) continue;
-          const Neighbour nb{nb_x[0], nb_x[1], nb_x[2],
-                             p.v[0][b], p.v[1][b], D == 3 ? p.v[D - 1][b] : 0.0f,
-                             p.vv[0][b], p.vv[1][b], D == 3 ? p.vv[D - 1][b] : 0.0f,
-                             p.pressure[b], p.inverse_density[b], p.excess[b], p.fluid[b]};
-          if constexpr (Bodies) {
-            if (booking.books(particles, b)) {
-              const unsigned body = particles.body[b];
-              if (!(booked_bodies & (1u << body))) {
-                lists.booked_count[body] = 0;
-                booked_bodies |= 1u << body;
-              }
-              lists.booked[body][lists.booked_count[body]++] = nb;
-              continue;
+      for_each_candidate([&](std::uint32_t b, const Neighbour& nb) {
+        if constexpr (Bodies) {
+          if (booking.books(particles, b)) {
+            const unsigned body = particles.body[b];
+            if (!(booked_bodies & (1u << body))) {
+              lists.booked_count[body] = 0;
+              booked_bodies |= 1u << body;
             }
+            lists.booked[body][lists.booked_count[body]++] = nb;
+            return;
           }
-          plain[plain_count++] = nb;
         }
-      }
+        plain[plain_count++] = nb;
+      });
       auto sweep = [&](const Neighbour* list, std::size_t count, float (*acc)[kBlock]) {
         if (k.two_mu != 0.0f) sweep_lanes<D, WithArtificialViscosity, WithKernelSum, true>(n, L, list, count, acc, k, W);
         else sweep_lanes<D, WithArtificialViscosity, WithKernelSum, false>(n, L, list, count, acc, k, W);
@@ -508,17 +514,7 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
         }
       }
     } else {
-    for (int sidx = 0; sidx < segment_count; ++sidx) {
-      const auto& seg = segments[sidx];
-      float shift[3] = {0, 0, 0};
-      for (int d = 0; d < D; ++d) shift[d] = static_cast<float>(seg.shift[d]);
-      for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
-        const float nb_x[3] = {p.x[0][b] + shift[0], p.x[1][b] + shift[1], D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f};
-        if (!near_box<D>(box_lo, box_hi, nb_x[0], nb_x[1], nb_x[2], k.support2)) continue;
-        const Neighbour nb{nb_x[0], nb_x[1], nb_x[2],
-                           p.v[0][b], p.v[1][b], D == 3 ? p.v[D - 1][b] : 0.0f,
-                           p.vv[0][b], p.vv[1][b], D == 3 ? p.vv[D - 1][b] : 0.0f,
-                           p.pressure[b], p.inverse_density[b], p.excess[b], p.fluid[b]};
+      for_each_candidate([&](std::uint32_t b, const Neighbour& nb) {
         if constexpr (Masked) {
           if (block_near || filter.is_near(b)) {
             // Pairs beyond the support have no weight anyway: ask only about the others.
@@ -542,12 +538,11 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
               booked_bodies |= 1u << body;
             }
             add_neighbour<D, WithArtificialViscosity, WithKernelSum, Masked, true>(L, nb, padded, k, W, &L.booked[body][0][0]);
-            continue;
+            return;
           }
         }
         add_neighbour<D, WithArtificialViscosity, WithKernelSum, Masked, false>(L, nb, padded, k, W, nullptr);
-      }
-    }
+      });
     }
     for (int i = 0; i < n; ++i) {
       const std::uint32_t a = lane_index[i];

@@ -236,6 +236,7 @@ int run_coupled(const cases::Case& c, const std::filesystem::path& case_file, co
         if (!state) throw std::runtime_error("the coupler asked for restart state, but the immersed-surface model cannot write it");
         state->push_back(NamedArray{std::string(kLastInterfaceForce), std::vector<double>(last_total.begin(), last_total.end())});
         write_restart_file(rank_restart_file(window.restart_directory, world), *state);
+        run_output.flush();  // a run continued from this point then has every probe sample before it
       }
       if (std::abs(solver.time() - window.time) > 1e-6 * window.size + 1e-12)
         throw std::runtime_error(fmt::format("fluid_sph: the coupler opened a window at t = {} s but the fluid is at t = {} s",

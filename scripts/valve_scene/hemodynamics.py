@@ -132,6 +132,9 @@ class CycleHemodynamics:
     section_stroke_volumes: dict    # section -> forward volume over [t1, t2], mL (2D: cm^2)
     pspd_probe_mmHg: float = float("nan")          # raw: the centre probes' largest dP over [t1, t2]
     peak_particle_speed: float | None = None       # raw: fastest particle on the velocity plane (m/s)
+    series_end_s: float | None = None              # partial cycle: the series ends here (s in the cycle);
+                                                   # leakage, regurgitant volume and the diastolic force
+                                                   # then cover only [t2, series_end_s]
 
 
 def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "downstream_tap",
@@ -271,11 +274,13 @@ def annulus_area(dimension: int, radius: float = ANNULUS_RADIUS_M) -> float:
 def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.PERIOD_S,
                   smoothing_s: float = 0.002, closure_time_s: float | None = None,
                   hydrostatic_Pa: float | None = None, annulus_radius: float = ANNULUS_RADIUS_M,
-                  symmetry_factor: float = 1.0) -> CycleHemodynamics:
+                  symmetry_factor: float = 1.0, allow_partial: bool = False) -> CycleHemodynamics:
     """Metrics of cycle `cycle` (1-based: [(cycle-1) T, cycle T)). closure_time_s, if given, is
     the valve's closure within the cycle (e.g. from the kinematics) and splits closing from
     leakage volume. symmetry_factor multiplies the flows and forces of a symmetric part (6 for
-    the 1/6 sector) into the whole valve's."""
+    the 1/6 sector) into the whole valve's. allow_partial accepts a series that ends before the
+    cycle does, once the forward flow has ended in it (a run that covers only the parts of the
+    cycle the metrics need): the result's series_end_s says where the diastolic quantities stop."""
     start, end = (cycle - 1) * period, cycle * period
     t_all = series.time
     sel = (t_all >= start - 1e-12) & (t_all <= end + 1e-12)
@@ -283,12 +288,16 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
         raise ValueError(f"cycle {cycle} ([{start:g}, {end:g}] s) has {np.count_nonzero(sel)} probe samples: "
                          f"the series covers [{t_all[0]:g}, {t_all[-1]:g}] s")
     t = t_all[sel]
-    if t[-1] < end - 0.05 * period:
+    partial = t[-1] < end - 0.05 * period
+    if partial and not allow_partial:
         raise ValueError(f"cycle {cycle} is incomplete: the series ends at {t[-1]:g} s, the cycle at {end:g} s")
     q = series.mean_flow_rate[sel] * symmetry_factor
     dp = series.pressure_drop[sel]
     q_s = moving_average(t, q, smoothing_s)
     t1, t2 = forward_flow_period(t, q_s)
+    if partial and t2 >= t[-1]:
+        raise ValueError(f"cycle {cycle} is incomplete and its forward flow has not ended: the series ends at "
+                         f"{t[-1]:g} s with the flow still positive")
     duration = t2 - t1
     # Volumes: m^3 -> mL is 1e6 (3D); m^2 -> cm^2 is 1e4 (2D, per depth). Rates likewise.
     to_volume = 1e6 if series.dimension == 3 else 1e4
@@ -339,7 +348,8 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
         peak_velocity_m_per_s=velocity, peak_velocity_time_s=velocity_time,
         pull_out_force=pull_out, diastolic_force=diastolic, diastolic_force_time_s=diastolic_time,
         hydrostatic_force=hydrostatic_force, water_hammer_ratio=ratio, section_stroke_volumes=sections,
-        pspd_probe_mmHg=pspd_probe, peak_particle_speed=particle_speed)
+        pspd_probe_mmHg=pspd_probe, peak_particle_speed=particle_speed,
+        series_end_s=float(t[-1] - start) if partial else None)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -394,6 +404,9 @@ def hemodynamics_table(results: dict) -> str:
         ("water-hammer ratio", lambda r: _f(r.water_hammer_ratio, 2), [ref_ratio(r) for r in refs]),
         ("forward flow (ms)", lambda r: f"{r.forward_start_s * 1e3:.0f}–{r.forward_end_s * 1e3:.0f}", ["–"] * len(refs)),
     ]
+    if any(r.series_end_s is not None for r in results.values()):
+        spec.append(("partial cycle: series ends at (ms); regurgitation and diastolic force up to it",
+                     lambda r: _f(r.series_end_s, 0, 1e3), ["–"] * len(refs)))
     for label, ours, theirs in spec:
         rows.append(f"| {label} | " + " | ".join(ours(results[m]) for m in models) + " | " + " | ".join(theirs) + " |")
     return "\n".join(rows) + "\n"
@@ -444,9 +457,12 @@ def main(argv=None) -> None:
                         help="flows and forces x this for the whole valve (6 for a 1/6-sector run)")
     parser.add_argument("--markdown", type=Path, help="write the table here")
     parser.add_argument("--png", type=Path, help="write the Fig. 11-like plot here")
+    parser.add_argument("--partial", action="store_true",
+                        help="accept a cycle the series does not finish, once its forward flow has ended")
     args = parser.parse_args(argv)
     series = read_run(args.run_dir, sections=args.sections)
-    result = analyse_cycle(series, args.cycle, closure_time_s=args.closure_time, symmetry_factor=args.symmetry_factor)
+    result = analyse_cycle(series, args.cycle, closure_time_s=args.closure_time, symmetry_factor=args.symmetry_factor,
+                           allow_partial=args.partial)
     table = hemodynamics_table({args.model: result})
     print(table)
     print("section stroke volumes:", {k: round(v, 3) for k, v in result.section_stroke_volumes.items()})

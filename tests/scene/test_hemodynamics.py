@@ -142,6 +142,36 @@ class Cycles(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "cycle 2 is incomplete: the series ends at 1.2 s"):
             hd.analyse_cycle(series, cycle=2)
 
+    def test_partial_cycle_through_closing_gives_the_systolic_metrics(self):
+        # a run that stops at 0.35 s, after the closing backflow (ends at TE + TC = 0.29 s)
+        full = synthetic(cycles=1)
+        cut, cut_f = full.time <= 0.35 + 1e-12, full.force_time <= 0.35 + 1e-12
+        part = hd.ProbeSeries(time=full.time[cut], upstream_pressure=full.upstream_pressure[cut],
+                              downstream_pressure=full.downstream_pressure[cut],
+                              flow_rates={k: v[cut] for k, v in full.flow_rates.items()},
+                              max_velocity=full.max_velocity[cut], force_time=full.force_time[cut_f],
+                              axial_force=full.axial_force[cut_f])
+        with self.assertRaisesRegex(ValueError, "cycle 1 is incomplete"):
+            hd.analyse_cycle(part, cycle=1, smoothing_s=0.0)
+        a = hd.analyse_cycle(full, cycle=1, smoothing_s=0.0, closure_time_s=TE + TC)
+        b = hd.analyse_cycle(part, cycle=1, smoothing_s=0.0, closure_time_s=TE + TC, allow_partial=True)
+        for key in ("mspd_mmHg", "pspd_mmHg", "eoa", "q_rms", "peak_flow", "closing_volume", "pull_out_force",
+                    "diastolic_force", "water_hammer_ratio", "peak_velocity_m_per_s"):
+            self.assertAlmostEqual(getattr(b, key), getattr(a, key), delta=1e-9 * max(1.0, abs(getattr(a, key))), msg=key)
+        self.assertAlmostEqual(b.leakage_volume, Q_LEAK * (0.35 - TE - TC) * 1e6, delta=1e-6)
+        self.assertAlmostEqual(b.series_end_s, 0.35, delta=1e-9)
+        self.assertIsNone(a.series_end_s)
+        self.assertIn("partial cycle: series ends at (ms)", hd.hemodynamics_table({"part": b}))
+
+    def test_partial_cycle_needs_the_forward_flow_to_end(self):
+        full = synthetic(cycles=1)
+        cut = full.time <= 0.2
+        part = hd.ProbeSeries(time=full.time[cut], upstream_pressure=full.upstream_pressure[cut],
+                              downstream_pressure=full.downstream_pressure[cut],
+                              flow_rates={k: v[cut] for k, v in full.flow_rates.items()}, max_velocity=None)
+        with self.assertRaisesRegex(ValueError, "forward flow has not ended"):
+            hd.analyse_cycle(part, cycle=1, smoothing_s=0.0, allow_partial=True)
+
     def test_noise_does_not_break_the_forward_period(self):
         # a 2 kHz ripple of 5 % of the peak (SPH-like) crosses zero many times near the ends
         r = hd.analyse_cycle(synthetic(noise=0.05), cycle=2, smoothing_s=0.002)

@@ -96,6 +96,7 @@ class RunResult:
     balance: dict = field(default_factory=dict)
     leaks: int | None = None
     cycle_difference: dict = field(default_factory=dict)  # metric -> relative difference, cycle 1 vs 2
+    cycle_values: tuple = ()                              # (previous cycle's, analysed cycle's) metrics
 
 
 # ---------------------------------------------------------------------------------------------
@@ -229,8 +230,40 @@ def _cycle_metrics(run: RunResult, cycle: int) -> dict:
     if run.spec.kind == "FSI":
         series = hd.read_run(run.run_dir)
         h = hd.analyse_cycle(series, cycle, closure_time_s=events.closing_end, symmetry_factor=run.spec.symmetry_factor)
-        metrics.update({"MSPD": h.mspd_mmHg, "peak flow": h.peak_flow, "stroke volume": h.stroke_volume})
+        metrics.update({"MSPD": h.mspd_mmHg, "PSPD": h.pspd_mmHg, "EOA": h.eoa, "peak flow": h.peak_flow,
+                        "stroke volume": h.stroke_volume})
+        if h.water_hammer_ratio is not None:
+            metrics["water-hammer ratio"] = h.water_hammer_ratio
     return metrics
+
+
+# Units and scale of each cycle metric in the cycle table (2D: per depth, as in Table 2's rows).
+CYCLE_METRIC_UNITS = {"RVOT": ("ms", 1e3), "RVCT": ("ms", 1e3), "ET": ("ms", 1e3), "peak radial position": ("mm", 1e3),
+                      "MSPD": ("mmHg", 1.0), "PSPD": ("mmHg", 1.0), "EOA": ("cm²; 2D cm", 1.0),
+                      "peak flow": ("mL/s; 2D cm²/s", 1.0), "stroke volume": ("mL; 2D cm²", 1.0),
+                      "water-hammer ratio": ("", 1.0)}
+
+
+def cycles_table(runs: dict, cycle: int) -> str:
+    """Each run's metrics in the previous and the analysed cycle, with their relative difference
+    |c_n - c_(n-1)| / |c_n| (the "cycles" finding's measure)."""
+    labels = [label for label, r in runs.items() if r.cycle_values]
+    if not labels:
+        return ""
+    lines = [f"| metric | {' | '.join(f'{l} c{cycle - 1} / c{cycle} (diff.)' for l in labels)} |",
+             "|---|" + "---|" * len(labels)]
+    for key, (unit, scale) in CYCLE_METRIC_UNITS.items():
+        cells = []
+        for label in labels:
+            first, second = runs[label].cycle_values
+            if key in first and key in second:
+                d = runs[label].cycle_difference[key]
+                cells.append(f"{first[key] * scale:.3g} / {second[key] * scale:.3g} ({'**' if d >= CYCLE_TOLERANCE else ''}{d:.0%}{'**' if d >= CYCLE_TOLERANCE else ''})")
+            else:
+                cells.append("–")
+        if any(c != "–" for c in cells):
+            lines.append(f"| {key}{f' ({unit})' if unit else ''} | {' | '.join(cells)} |")
+    return "\n".join(lines) + "\n"
 
 
 def analyse_run(run: RunResult, cycle: int) -> RunResult:
@@ -260,9 +293,11 @@ def analyse_run(run: RunResult, cycle: int) -> RunResult:
     if cycle >= 2:
         try:
             first, second = _cycle_metrics(run, cycle - 1), _cycle_metrics(run, cycle)
-            run.cycle_difference = {k: abs(second[k] - first[k]) / max(abs(second[k]), 1e-300) for k in second}
+            run.cycle_difference = {k: abs(second[k] - first[k]) / max(abs(second[k]), 1e-300) for k in second if k in first}
+            run.cycle_values = (first, second)
         except (FileNotFoundError, KeyError, ValueError, IndexError):
             run.cycle_difference = {}
+            run.cycle_values = ()
     return run
 
 
@@ -539,6 +574,11 @@ def write_report(runs: dict, out: Path, command: str, cycle: int, dimension: int
         verdict = {True: "yes", False: "**no**", None: "not measured"}[f.holds]
         lines.append(f"| {f.key} | {REFERENCE_FINDINGS[f.key]} | {verdict} | {f.evidence} |")
     lines += [""]
+    table = cycles_table(runs, cycle)
+    if table:
+        lines += [f"## Cycle {cycle - 1} against cycle {cycle} (the \"cycles\" finding)", "",
+                  f"Each metric measured the same way in both cycles; the difference is |c{cycle} − c{cycle - 1}| / |c{cycle}|, "
+                  f"in bold where it reaches {CYCLE_TOLERANCE:.0%}.", "", table]
     plot_fig5(runs, figures / f"{stem}-fig5.png")
     lines += ["## Figures", "", f"Free-edge motion (like Fig. 5; dashed FE-only, solid FSI):", "",
               f"![fig5](figures/{stem}-fig5.png)", ""]

@@ -128,6 +128,10 @@ def run_metrics(run_dir: Path, dimension: int = 2, material: str = "MHGO") -> di
         if len(solid.time) > 1:
             speed = np.linalg.norm(np.diff(x, axis=0), axis=-1) / np.diff(solid.time)[:, None]
             out["max_edge_speed"] = float(np.max(speed))
+            # where and when: the free-edge midpoint at the end of the fastest sample interval
+            sample, midpoint = np.unravel_index(int(np.argmax(speed)), speed.shape)
+            out["max_edge_speed_time"] = float(solid.time[sample + 1])
+            out["max_edge_speed_where_mm"] = [float(v) * 1e3 for v in x[sample + 1, midpoint]]
         energy = solid.energy_balance_error
         if np.any(np.isfinite(energy)):
             out["max_energy_error"] = float(np.nanmax(np.abs(energy)))

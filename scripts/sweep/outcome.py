@@ -62,7 +62,7 @@ class Outcome:
     unconverged_windows: int = 0
 
 
-def _shortened(line: str, keep: int = 400) -> str:
+def shortened(line: str, keep: int = 400) -> str:
     """An error line for the table: its start (what failed) and its end (the remedy)."""
     line = line.strip()
     if len(line) <= keep:
@@ -99,9 +99,39 @@ def _coupling_series(run_dir: Path):
         return {}
 
 
+# what to change when the post-mortem finds a runaway no program stopped (the levers of the
+# stability map, docs/stability-map.md)
+RUNAWAY_REMEDY = ("not stopped by any program; lower time_step_factor (the coupling window and the fluid CFL), "
+                  "make the leaflet heavier (a smaller added-mass number mu) or couple implicitly (IQN-ILS)")
+
+
+def _force_where(series: dict, bound: float) -> str:
+    """When the interface force first passed `bound` and when it peaked (the post-mortem's 'where')."""
+    t, force = series.get("time"), series.get("force_fluid")
+    if t is None or force is None or not len(t):
+        return ""
+    size = np.abs(np.nan_to_num(force, nan=np.inf)).max(axis=-1) if force.ndim > 1 else np.abs(force)
+    over = np.flatnonzero(size > bound)
+    if not len(over):
+        return ""
+    return (f"first above {bound:g} N/m in the window ending at t = {t[over[0]] * 1e3:.2f} ms, "
+            f"largest at t = {t[int(np.argmax(size))] * 1e3:.2f} ms")
+
+
+def _edge_where(edge_speed_at) -> str:
+    if not edge_speed_at:
+        return ""
+    time_s, where_mm = edge_speed_at
+    return (f"fastest free edge at t = {time_s * 1e3:.2f} ms, at ("
+            + ", ".join(f"{v:.2f}" for v in where_mm) + ") mm")
+
+
 def classify(run_dir: Path, exit_code: int, end_time: float, timed_out: bool = False,
              launcher_log: Path | None = None, leaks: int | None = None, max_edge_speed: float | None = None,
-             force_bound: float = FORCE_BOUND_N_PER_M, speed_bound: float = SPEED_BOUND_M_PER_S) -> Outcome:
+             force_bound: float = FORCE_BOUND_N_PER_M, speed_bound: float = SPEED_BOUND_M_PER_S,
+             edge_speed_at: tuple | None = None) -> Outcome:
+    """`edge_speed_at` = (time s, position mm) of `max_edge_speed`: with the force series it says
+    where a runaway that no program stopped happened."""
     run_dir = Path(run_dir)
     reached = _reached(run_dir)
     logs = {role: _lines(run_dir / f"{role}.log") for role in ("fluid", "solid", "coupler")}
@@ -127,15 +157,16 @@ def classify(run_dir: Path, exit_code: int, end_time: float, timed_out: bool = F
                     if kind == "time-step collapse" and speed and float(speed.group(1)) > speed_bound:
                         # the step collapsed because the solid's motion ran away (an implicit
                         # iterate, an explicit blow-up): the coupling diverged, the guard caught it
-                        return Outcome("coupling divergence", _shortened(line), f"{role} (time-step guard)",
+                        return Outcome("coupling divergence", shortened(line), f"{role} (time-step guard)",
                                        reached, unconverged)
-                    return Outcome(kind, _shortened(line), role, reached, unconverged)
+                    return Outcome(kind, shortened(line), role, reached, unconverged)
         if timed_out:
             return Outcome("timeout", f"stopped at the wall-time limit at t = {reached}", "", reached, unconverged)
         if force_max is not None and force_max > force_bound:
             return Outcome("energy growth", f"|interface force| reached {force_max:.3g} N/m "
-                           f"(exit code {exit_code}, no program named it)", "", reached, unconverged)
-        detail = _shortened(errors[0][1]) if errors else f"exit code {exit_code}, no error line in the logs"
+                           f"({_force_where(series, force_bound)}; exit code {exit_code}, no program named it); "
+                           f"{RUNAWAY_REMEDY}", "", reached, unconverged)
+        detail = shortened(errors[0][1]) if errors else f"exit code {exit_code}, no error line in the logs"
         return Outcome("other", detail, errors[0][0] if errors else "", reached, unconverged)
 
     if reached is None or reached < end_time - 1e-9:
@@ -147,9 +178,10 @@ def classify(run_dir: Path, exit_code: int, end_time: float, timed_out: bool = F
         return Outcome("leaks", f"completed with {leaks} particle(s) through a leaflet (counted, not stopped)",
                        "", reached, unconverged)
     if force_max is not None and force_max > force_bound:
-        return Outcome("energy growth", f"completed, but the interface force reached {force_max:.3g} N/m",
-                       "", reached, unconverged)
+        where = "; ".join(w for w in (_force_where(series, force_bound), _edge_where(edge_speed_at)) if w)
+        return Outcome("energy growth", f"completed, but the interface force reached {force_max:.3g} N/m "
+                       f"({where}); {RUNAWAY_REMEDY}", "", reached, unconverged)
     if max_edge_speed is not None and max_edge_speed > speed_bound:
-        return Outcome("energy growth", f"completed, but a free edge reached {max_edge_speed:.3g} m/s",
-                       "", reached, unconverged)
+        return Outcome("energy growth", f"completed, but a free edge reached {max_edge_speed:.3g} m/s "
+                       f"({_edge_where(edge_speed_at)}); {RUNAWAY_REMEDY}", "", reached, unconverged)
     return Outcome("completed", "", "", reached, unconverged)

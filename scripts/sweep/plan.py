@@ -133,7 +133,9 @@ def measure(run_dir: Path, work: Path, scene: str, setting: dict, end_time: floa
     material = str(setting.get("material", "MHGO"))
     measured = metrics_module.run_metrics(run_dir, dimension=2 if scene == "valve2d" else 3, material=material)
     ending = outcome_module.classify(run_dir, exit_code, end_time, timed_out, launcher_log=work / "launcher.log",
-                                     leaks=measured.get("leaks"), max_edge_speed=measured.get("max_edge_speed"))
+                                     leaks=measured.get("leaks"), max_edge_speed=measured.get("max_edge_speed"),
+                                     edge_speed_at=((measured["max_edge_speed_time"], measured["max_edge_speed_where_mm"])
+                                                    if "max_edge_speed_where_mm" in measured else None))
     return measured, ending
 
 

@@ -19,42 +19,53 @@ PRESETS = {
         "end_time": OPENING_END_S,
         "span": "opening only, 0-100 ms of the first cycle (no EOA, RVCT, diastolic force or closed stress)",
         "base": {"material": "MHGO"},
-        # spacings 23 mm / n (n = 12, 16, 23, 30): the orifice spans whole spacings (valve2d.on_lattice).
-        # c0 = 40 only for the finest and, last, at 1 mm: the window (mu = 1) shrinks as 1/c0 at every
-        # spacing, so a run's cost grows with c0 x particles, and the solid sub-cycles through
-        # 0.65-1.2 M steps per 0.1 s in these runs (measured); the full grid does not fit a session.
-        # The finest runs right after the coarse ones, so that a sweep cut short has its reference.
+        # spacings 23 mm / n (n = 16, 23, 30, 40): the orifice spans whole spacings (valve2d.on_lattice).
+        # A run costs about c0 x particles (the window shrinks as 1/c0); the full grid does not fit
+        # a session on a shared machine. The committed case (1 mm, 20 m/s) runs first, then the
+        # finest, so that a sweep cut short has its reference; 0.575 mm (n = 40, ~2.4x the finest's
+        # CPU) runs last, for the convergence in the spacing. n = 12 (1.917 mm) is left out: in
+        # session 4 every run at 1.917 and 1.4375 mm fluttered (17-32 m/s edges); n = 16 keeps one.
         "runs": [{"group": "grid", "setting": {"spacing_mm": 23.0 / n, "sound_speed": c}}
-                 for n, c in ((12, 10.0), (12, 20.0), (16, 10.0), (16, 20.0), (30, 40.0), (23, 20.0), (23, 10.0),
-                              (23, 40.0))],
+                 for n, c in ((23, 20.0), (30, 40.0), (23, 10.0), (23, 40.0), (30, 20.0), (16, 20.0), (40, 40.0))],
         "finest": {"spacing_mm": 23.0 / 30, "sound_speed": 40.0},
         "wall_limit_s": 3600,
     },
     # Stability map: each group varies one thing from the committed coarse case (the default
-    # run, shared by every group, is listed in the first).
+    # run, shared by every group, is listed in the first). Since session 6 the base leaflet is
+    # 2200 kg/m^3 (mu = 1 at the 13 us window) damped at 200/s, so the added-mass rows are the
+    # densities of mu = 1, 2, 4, 8, 20 and the undamped rows say what the damping buys.
     "stability-2d": {
         "scene": "valve2d",
         "report": "stability",
         "end_time": 0.03,
         "span": "0-30 ms of the first cycle (start-up and the first pressure wave; the leaflets start to open at 30-50 ms)",
         "base": {"material": "MHGO"},
+        # The questions of issue 8 item 2 run first (the largest stable factor, the lowest c0,
+        # explicit vs implicit as mu grows, delta, thickness); the groups after them say why
+        # (window vs fluid step, damping, background pressure) and run when the machine allows.
         "runs": (
             [{"group": "time-step factor", "setting": {}}]
             + [{"group": "time-step factor", "setting": {"time_step_factor": f}} for f in (1.5, 2.0, 3.0)]
-            # the window grows but the fluid keeps its step (cfl 0.1 x h / c0 = 6.5 us, sub-cycled):
-            # which of the two limits the factor
-            + [{"group": "window only", "setting": {"time_step_factor": f, "set:fluid.cfl": 0.1}} for f in (0.5, 1.5)]
-            # the fluid's step alone, at the committed window
-            + [{"group": "fluid step", "setting": {"set:fluid.cfl": c}} for c in (0.15, 0.2)]
             + [{"group": "sound speed", "setting": {"sound_speed": c}} for c in (2.5, 5.0, 10.0)]
-            + [{"group": "added mass, explicit", "setting": {"leaflet_density": rho}} for rho in (550.0, 275.0, 110.0)]
+            + [{"group": "added mass, explicit", "setting": {"leaflet_density": rho}}
+               for rho in (1100.0, 550.0, 275.0, 110.0)]
             + [{"group": "added mass, implicit", "setting": {"leaflet_density": rho, "coupling": "implicit"}}
                for rho in (1100.0, 275.0, 110.0)]
             + [{"group": "density diffusion", "setting": {"density_diffusion": 0.0}}]
+            + [{"group": "thickness / spacing", "setting": {"thickness_mm": t}} for t in (0.5, 0.125, 0.0625)]
+            # the cases' 200/s mass damping off: where explicit coupling fails without it
+            + [{"group": "added mass, explicit, undamped",
+                "setting": {"leaflet_density": rho, "set:solid.mass_damping_per_s": 0.0}}
+               for rho in (2200.0, 1100.0)]
+            # the window grows but the fluid keeps its step (cfl 0.1 x h / c0 = 6.5 us, sub-cycled):
+            # which of the two limits the factor
+            + [{"group": "window only", "setting": {"time_step_factor": f, "set:fluid.cfl": 0.1}} for f in (0.5, 2.0)]
+            # the fluid's step alone, at the committed window
+            + [{"group": "fluid step", "setting": {"set:fluid.cfl": c}} for c in (0.15, 0.2)]
             # the committed cases start at gauge 0; a background pressure (the aortic pressure at
             # opening) acts through the leaflet's incomplete kernels
             + [{"group": "background pressure", "setting": {"background_pressure": "on"}}]
-            + [{"group": "thickness / spacing", "setting": {"thickness_mm": t}} for t in (0.5, 0.125, 0.0625)]
+            + [{"group": "added mass, implicit", "setting": {"leaflet_density": 2200.0, "coupling": "implicit"}}]
         ),
         "wall_limit_s": 900,
     },

@@ -83,6 +83,15 @@ def _axis_value(axis: str, value) -> str:
     return _short(value)
 
 
+def load_text(cost: dict) -> str:
+    """The machine's 1-minute load average at a run's start and end ('–' for runs recorded
+    before the sweep kept it): the wall time of a run on a shared machine depends on it."""
+    start, end = (cost.get("load_avg") or (None, None))
+    if start is None or end is None:
+        return "–"
+    return f"{start:.1f}–{end:.1f}"
+
+
 def _pct(value) -> str:
     return "–" if value is None else f"{100 * value:+.1f} %"
 
@@ -107,7 +116,7 @@ def markdown(results: list[dict], finest_label: str | None = None, tolerance: fl
         lines.append(f"Span: {results[0].get('span') or 'end time ' + str(results[0]['end_time']) + ' s'}. "
                      f"Common setting: {', '.join(f'{k} = {_short(v)}' for k, v in constant.items()) or 'none'}.")
         lines.append("")
-    head = axes + ["end", "wall (s)", "core-h", "CPU fluid / solid / coupler (s)", "peak RSS fluid / solid / coupler (MB)"]
+    head = axes + ["end", "wall (s)", "load", "core-h", "CPU fluid / solid / coupler (s)", "peak RSS fluid / solid / coupler (MB)"]
     head += [title for _m, title, _s, _d in SHOWN if any(r["metrics"].get(_m) is not None for r in rows)]
     shown = [(m, t, s, d) for m, t, s, d in SHOWN if t in head]
     head += ["max error vs finest", "peak v vs reference"]
@@ -120,7 +129,7 @@ def markdown(results: list[dict], finest_label: str | None = None, tolerance: fl
         reached = r["outcome"]["reached_s"]
         cells.append(kind if kind == "completed" else f"{kind} at {_fmt(reached, 1e3, 1)} ms")
         cpu = r["cost"]["cpu_s_by_program"]
-        cells += [f"{r['cost']['wall_s']:.0f}", f"{r['core_hours']:.4f}",
+        cells += [f"{r['cost']['wall_s']:.0f}", load_text(r["cost"]), f"{r['core_hours']:.4f}",
                   " / ".join(f"{cpu.get(p, 0):.0f}" for p in ("fluid", "solid", "coupler")),
                   " / ".join(f"{rss.get(p, 0):.0f}" for p in ("fluid", "solid", "coupler"))]
         for m, _t, scale, digits in shown:

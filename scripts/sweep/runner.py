@@ -1,6 +1,6 @@
 """One run of a setting through scripts/run_case.py, with what it cost.
 
-Cost: wall time of the launcher; CPU time (user + system) of all processes, exactly, from
+Cost: wall time of the launcher and the 1-minute load average at its start and end; CPU time (user + system) of all processes, exactly, from
 wait4's resource usage of the launcher (which waits for each program, so their times are
 included); per program, CPU time and peak resident memory (VmHWM) sampled from /proc every
 `poll_s` while it runs (the last sample can miss up to `poll_s` of CPU; the total does not).
@@ -31,6 +31,9 @@ class RunCost:
     cpu_s_by_program: dict = field(default_factory=dict)     # sampled
     peak_rss_mb_by_program: dict = field(default_factory=dict)
     timed_out: bool = False
+    # the machine's 1-minute load average when the run started and ended: on a shared machine the
+    # wall time says little without it (CPU time is the stable measure)
+    load_avg: tuple = (None, None)
 
     @property
     def core_hours(self) -> float:
@@ -88,6 +91,7 @@ def run_case(case: Path, output: Path, build_dir: Path, log_path: Path, wall_lim
                "--build-dir", str(build_dir)] + (extra_args or [])
     cpu_by, rss_by = {}, {}
     timed_out = False
+    load_start = os.getloadavg()[0]
     started = time.monotonic()
     with open(log_path, "w") as log:
         log.write("# " + " ".join(command) + "\n")
@@ -114,7 +118,8 @@ def run_case(case: Path, output: Path, build_dir: Path, log_path: Path, wall_lim
     process.returncode = os.waitstatus_to_exitcode(status)
     code = process.returncode if process.returncode >= 0 else 128 - process.returncode
     return RunCost(exit_code=code, wall_s=time.monotonic() - started, cpu_s=usage.ru_utime + usage.ru_stime,
-                   cpu_s_by_program=cpu_by, peak_rss_mb_by_program=rss_by, timed_out=timed_out)
+                   cpu_s_by_program=cpu_by, peak_rss_mb_by_program=rss_by, timed_out=timed_out,
+                   load_avg=(load_start, os.getloadavg()[0]))
 
 
 def save_json(path: Path, data: dict) -> None:

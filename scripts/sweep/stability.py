@@ -7,7 +7,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from . import scenes
+from . import outcome, report, scenes
 
 KIND_COLOURS = {"completed": "tab:green", "leaks": "tab:olive", "nan": "tab:red", "time-step collapse": "tab:orange",
                 "solid failure": "tab:brown", "coupling divergence": "tab:purple", "energy growth": "tab:pink",
@@ -72,24 +72,23 @@ def markdown(results: list[dict], order: list | None = None) -> str:
     if results:
         lines += [f"Span: {results[0].get('span') or results[0]['end_time']}.", ""]
     lines += ["| group | setting | μ | dp / t | end | reached (ms) | stopped by | message or measure "
-              "| max edge speed (m/s) | max interface force (N/m) | leaks | wall (s) | CPU (s) |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+              "| max edge speed (m/s) | max interface force (N/m) | leaks | wall (s) | CPU (s) | load |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for group, members in groups_of(results, order).items():
         axis = varied_axis(members) or "setting"
         for r in sorted(members, key=lambda r: (str(type(_value(r, axis))), _value(r, axis))):
             s = {**scenes.VALVE2D_DEFAULTS, **r["setting"]}
             o = r["outcome"]
             shown = ", ".join(f"{k} = {v}" for k, v in r["setting"].items() if k != "material")
-            detail = re.sub(r"^(\[[^\]]*\]\s*)+", "", (o["detail"] or "")).replace("|", "/")
-            if len(detail) > 160:
-                detail = detail[:157] + "..."
+            # what failed (the start) and what to change (the end) both stay
+            detail = outcome.shortened(re.sub(r"^(\[[^\]]*\]\s*)+", "", (o["detail"] or "")).replace("|", "/"), 320)
             reached = "–" if o["reached_s"] is None else f"{o['reached_s'] * 1e3:.1f}"
             lines.append(f"| {group} | {shown or 'default'} | {mu_of(r['setting']):.2g} | "
                          f"{float(s['spacing_mm']) / float(s['thickness_mm']):.0f} | {o['kind']} | {reached} | "
                          f"{o['detected_by'] or '(not stopped)' if o['kind'] != 'completed' else ''} | {detail} | "
                          f"{_num(r['metrics'].get('max_edge_speed'))} | {_num(r['metrics'].get('max_interface_force'))} | "
                          f"{r['metrics'].get('leaks', '–')} | "
-                         f"{r['cost']['wall_s']:.0f} | {r['cost']['cpu_s']:.0f} |")
+                         f"{r['cost']['wall_s']:.0f} | {r['cost']['cpu_s']:.0f} | {report.load_text(r['cost'])} |")
     return "\n".join(lines) + "\n"
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from sweep import case_edit, metrics, outcome, plan, report, scenes
+from sweep import case_edit, metrics, outcome, plan, report, runner, scenes, stability
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -311,6 +311,27 @@ class Classify(unittest.TestCase):
         write_logs(self.dir, {"coupler": "[warning] coupler: window 7 (t = 1e-4 s) not converged after 30 iterations\n"})
         self.assertEqual(outcome.classify(self.dir, 0, 0.1).kind, "coupling divergence")
 
+    def test_a_runaway_no_program_stopped_says_when_where_and_what_to_change(self):
+        write_logs(self.dir, {"coupler": "", "fluid": "", "solid": ""})
+        t = [0.010, 0.011, 0.012, 0.013, 0.030]
+        write_coupling(self.dir, t, [[3, 0, 0], [0, 499, 0], [0, -620, 0], [1890, 0, 0], [40, 0, 0]])
+        o = outcome.classify(self.dir, 0, 0.03, max_edge_speed=12.0, edge_speed_at=(0.0131, [0.5, -7.25, 0.0]))
+        self.assertEqual((o.kind, o.detected_by), ("energy growth", ""))
+        self.assertIn("1.89e+03 N/m", o.detail)
+        self.assertIn("first above 500 N/m in the window ending at t = 12.00 ms", o.detail)   # |-620| > 500
+        self.assertIn("largest at t = 13.00 ms", o.detail)
+        self.assertIn("fastest free edge at t = 13.10 ms, at (0.50, -7.25, 0.00) mm", o.detail)
+        self.assertIn("lower time_step_factor", o.detail)
+        # the edge alone (force within bounds) names the edge's time and place
+        write_coupling(self.dir, t, np.ones((5, 3)))
+        o = outcome.classify(self.dir, 0, 0.03, max_edge_speed=12.0, edge_speed_at=(0.0131, [0.5, -7.25, 0.0]))
+        self.assertIn("a free edge reached 12 m/s (fastest free edge at t = 13.10 ms", o.detail)
+        # a failed run that no program explained: the force's times and the remedy
+        write_coupling(self.dir, t[:4], [[3, 0, 0], [0, 499, 0], [0, 501, 0], [np.nan, 0, 0]])
+        o = outcome.classify(self.dir, 1, 0.03)
+        self.assertIn("first above 500 N/m in the window ending at t = 12.00 ms", o.detail)
+        self.assertIn("couple implicitly", o.detail)
+
     def test_run_short_of_its_end_is_not_completed(self):
         write_logs(self.dir, {"coupler": "", "fluid": "", "solid": ""})
         write_coupling(self.dir, [0.05], np.ones((1, 3)))
@@ -339,6 +360,41 @@ class CheapestWithin(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             report.chart(results, Path(tmp) / "c.png", "f")
             self.assertGreater((Path(tmp) / "c.png").stat().st_size, 1000)
+
+
+class MachineLoad(unittest.TestCase):
+    def test_a_run_records_the_load_at_its_start_and_end(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            fake = Path(tmp) / "launcher.py"   # stands in for scripts/run_case.py: burns a little CPU
+            fake.write_text("import sys\nsum(i * i for i in range(200000))\nsys.exit(3)\n")
+            saved, runner.LAUNCHER = runner.LAUNCHER, fake
+            try:
+                cost = runner.run_case(Path(tmp) / "case.textproto", Path(tmp) / "run", Path(tmp), Path(tmp) / "log",
+                                       poll_s=0.05)
+            finally:
+                runner.LAUNCHER = saved
+        self.assertEqual(cost.exit_code, 3)
+        self.assertGreater(cost.cpu_s, 0.0)
+        self.assertEqual(len(cost.load_avg), 2)
+        self.assertTrue(all(isinstance(v, float) and v >= 0.0 for v in cost.load_avg))
+
+    def test_both_tables_show_the_load_and_a_dash_for_runs_recorded_without_it(self):
+        loaded = fake_result("1", 10, {"peak_velocity": 1.0})
+        loaded["cost"]["load_avg"] = [3.25, 7.5]
+        old = fake_result("2", 20, {"peak_velocity": 1.0})
+        self.assertEqual(report.load_text(loaded["cost"]), "3.2–7.5")
+        self.assertEqual(report.load_text(old["cost"]), "–")
+        table = report.markdown([loaded, old], "2")
+        self.assertIn("| load |", table)
+        self.assertIn("| 3.2–7.5 |", table)
+        loaded["setting"] = {"material": "MHGO", "sound_speed": 10.0}
+        old["setting"] = {"material": "MHGO"}
+        for r in (loaded, old):
+            r["metrics"].update(max_edge_speed=0.5, max_interface_force=3.0, leaks=0)
+        rows = stability.markdown([loaded, old]).splitlines()
+        self.assertIn("| load |", rows[2])
+        self.assertEqual(sum(row.endswith("| 3.2–7.5 |") for row in rows), 1)
+        self.assertEqual(sum(row.endswith("| – |") for row in rows), 1)
 
 
 class Plan(unittest.TestCase):

@@ -193,6 +193,9 @@ FluidSetup<D> fluid_setup_from_case(const cases::Case& c, const std::filesystem:
   s.plate_pressure_floor = f.plate_pressure_floor_mmhg() * kPascalPerMmHg;
   if (s.plates_never_pull && setup.plates.empty())
     in.fail("plates_never_pull", "= true, but the case has no plates: allowed only with at least one entry in fluid.plates");
+  s.plate_floor_once_reached = f.plate_pressure_floor_once_reached();
+  if (s.plate_floor_once_reached && !s.plates_never_pull)
+    in.fail("plate_pressure_floor_once_reached", "= true, but plates_never_pull is false: set plates_never_pull: true or remove it");
   if (!s.plates_never_pull && f.plate_pressure_floor_mmhg() != 0)
     in.fail("plate_pressure_floor_mmHg", fmt::format("= {}, but plates_never_pull is false: set plates_never_pull: true or remove it",
                                                      f.plate_pressure_floor_mmhg()));

@@ -46,6 +46,7 @@ struct FluidSolver<D>::Checkpoint {
   double time = 0.0, dt = 0.0;
   long steps = 0;
   std::size_t lost = 0, lost_density = 0;
+  bool plate_floor_reached = true;
   float max_speed = 0.0f, max_acceleration = 0.0f;
   std::size_t owned_begin = 0, owned_end = 0;
 };
@@ -78,6 +79,8 @@ FluidSolver<D>::FluidSolver(const FluidSettings<D>& settings, Particles<D> parti
       throw std::invalid_argument(std::string("fluid settings: mirror_planes: ") + e.what());
     }
   }
+  plate_floor_reached_ = !settings_.plate_floor_once_reached;
+  note_plate_floor(time_);
   refresh_mirror_images();
   initial_fluid_count_ = particles_.count(Kind::fluid);
   leak_limit_ = static_cast<std::size_t>(std::floor(settings_.max_leak_fraction * static_cast<double>(initial_fluid_count_)));
@@ -292,6 +295,7 @@ void FluidSolver<D>::save_checkpoint() {
   c.steps = steps_;
   c.lost = lost_;
   c.lost_density = lost_density_;
+  c.plate_floor_reached = plate_floor_reached_;
   c.max_speed = max_speed_;
   c.max_acceleration = max_acceleration_;
   c.owned_begin = owned_begin_;
@@ -314,6 +318,7 @@ void FluidSolver<D>::restore_checkpoint() {
   steps_ = c.steps;
   lost_ = c.lost;
   lost_density_ = c.lost_density;
+  plate_floor_reached_ = c.plate_floor_reached;
   max_speed_ = c.max_speed;
   max_acceleration_ = c.max_acceleration;
   owned_begin_ = c.owned_begin;
@@ -380,6 +385,7 @@ void FluidSolver<D>::step() {
     }
   }
   time_ += dt;
+  note_plate_floor(time_);
   if (surface_) {
     surface_->move_to(time_);
     surface_->correct_crossings(p);
@@ -461,11 +467,26 @@ void FluidSolver<D>::step() {
 }
 
 template <int D>
-double FluidSolver<D>::plate_pressure_level(double t) const {
-  if (!settings_.plates_never_pull || plates_.empty()) return 0.0;
+double FluidSolver<D>::lowest_plate_drive(double t) const {
   double lowest = std::numeric_limits<double>::infinity();
   for (const auto& plate : plates_) lowest = std::min(lowest, plate.pressure(t));
-  return std::max(0.0, settings_.plate_pressure_floor - (settings_.background_pressure + lowest));
+  return settings_.background_pressure + lowest;
+}
+
+template <int D>
+double FluidSolver<D>::plate_pressure_level(double t) const {
+  if (!settings_.plates_never_pull || plates_.empty()) return 0.0;
+  // Before a once-reached floor is reached the plates only never pull. At the step that
+  // reaches it the lowest drive is at or above the floor, so the level is 0 either way and
+  // it does not jump when the floor engages.
+  const double floor = plate_floor_reached_ ? settings_.plate_pressure_floor : 0.0;
+  return std::max(0.0, floor - lowest_plate_drive(t));
+}
+
+template <int D>
+void FluidSolver<D>::note_plate_floor(double t) {
+  if (plate_floor_reached_ || !settings_.plates_never_pull || plates_.empty()) return;
+  if (lowest_plate_drive(t) >= settings_.plate_pressure_floor) plate_floor_reached_ = true;
 }
 
 template <int D>

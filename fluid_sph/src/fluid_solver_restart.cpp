@@ -40,6 +40,7 @@ class Lookup {
     return *it->second;
   }
   double scalar(const std::string& name) const { return get(name, 1)[0]; }
+  bool has(const std::string& name) const { return by_name_.contains(name); }
   template <class T>
   void into(const std::string& name, std::vector<T>& out, std::ptrdiff_t expected = -1) const {
     const auto& values = get(name, expected);
@@ -126,6 +127,7 @@ std::optional<std::vector<NamedArray>> FluidSolver<D>::restart_state() const {
   out.push_back(scalar("max_speed", max_speed_));
   out.push_back(scalar("max_acceleration", max_acceleration_));
   out.push_back(scalar("body_forces_requested", body_forces_requested_ ? 1.0 : 0.0));
+  out.push_back(scalar("plate_floor_reached", plate_floor_reached_ ? 1.0 : 0.0));
   if (surface_state)
     for (auto& a : *surface_state) out.push_back(NamedArray{std::string(kSurfacePrefix) + a.name, std::move(a.values)});
   return out;
@@ -201,6 +203,16 @@ void FluidSolver<D>::load_restart_state(std::span<const NamedArray> arrays) {
   max_speed_ = static_cast<float>(in.scalar("max_speed"));
   max_acceleration_ = static_cast<float>(in.scalar("max_acceleration"));
   body_forces_requested_ = in.scalar("body_forces_requested") != 0.0;
+  if (in.has("plate_floor_reached")) {
+    plate_floor_reached_ = in.scalar("plate_floor_reached") != 0.0;
+  } else {
+    // Files written before the flag existed: the drives depend on time only, so replay them
+    // at the file's step from 0 to its time.
+    plate_floor_reached_ = !settings_.plate_floor_once_reached;
+    const double sample = dt_ > 0 ? dt_ : 1e-6;
+    for (double t = 0.0; t < time_ && !plate_floor_reached_; t += sample) note_plate_floor(t);
+    note_plate_floor(time_);
+  }
   checkpoint_.reset();
 
   std::vector<NamedArray> surface_arrays;

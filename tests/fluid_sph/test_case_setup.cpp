@@ -167,6 +167,20 @@ TEST(CaseSetup, PlatesNeverPullIsReadAndChecked) {
   const FluidSetup<2> setup = fluid_setup_from_case<2>(parse_case_text(text, "channel.textproto"), "channel.textproto");
   EXPECT_TRUE(setup.settings.plates_never_pull);
   EXPECT_NEAR(setup.settings.plate_pressure_floor, 2 * 133.322387415, 1e-9);
+  EXPECT_FALSE(setup.settings.plate_floor_once_reached);
+  std::string once = text;
+  once.replace(once.find("  probes {"), 0, "  plate_pressure_floor_once_reached: true\n");
+  EXPECT_TRUE(fluid_setup_from_case<2>(parse_case_text(once, "channel.textproto"), "channel.textproto").settings.plate_floor_once_reached);
+  std::string once_alone = kChannel;
+  once_alone.replace(once_alone.find("  probes {"), 0, "  plate_pressure_floor_once_reached: true\n");
+  try {
+    fluid_setup_from_case<2>(parse_case_text(once_alone, "channel.textproto"), "channel.textproto");
+    FAIL() << "expected a CaseError";
+  } catch (const CaseError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("channel.textproto: field 'fluid.plate_pressure_floor_once_reached' = true, but plates_never_pull is false"),
+              std::string::npos) << what;
+  }
 
   std::string floor_only = kChannel;
   floor_only.replace(floor_only.find("  probes {"), 0, "  plate_pressure_floor_mmHg: 2\n");

@@ -40,6 +40,11 @@ struct FluidSettings {
   // probes and snapshots report p - background - level (the waveform's reference).
   bool plates_never_pull = false;
   double plate_pressure_floor = 0.0;  // Pa
+  // With plates_never_pull: until the lowest plate's absolute drive first reaches
+  // plate_pressure_floor the floor is 0 (the plates only never pull); from then on the floor
+  // holds. A drive that starts below the floor then starts as without one, and the floor still
+  // catches a plate that the closing water hammer kicks away from the blood.
+  bool plate_floor_once_reached = false;
   Vec<D> gravity{};                     // body acceleration (m/s^2)
   // Particle shifting (Skillen et al. 2013 form): each step a fluid particle moves by
   // -A h U dt grad C, with C the kernel sum, U the largest fluid speed and A this

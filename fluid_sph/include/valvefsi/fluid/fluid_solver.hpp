@@ -109,9 +109,13 @@ class FluidSolver {
   const std::vector<PressurePlate<D>>& plates() const { return plates_; }
   // The common level added to every plate's prescribed pressure at time t (Pa): with
   // settings().plates_never_pull the least that keeps every plate's absolute pressure at or
-  // above settings().plate_pressure_floor, else 0.
+  // above settings().plate_pressure_floor (0 while a plate_floor_once_reached floor has not
+  // been reached by time()), else 0.
   double plate_pressure_level(double t) const;
   double plate_pressure_level() const { return plate_pressure_level(time_); }
+  // Whether the lowest plate's absolute drive has reached settings().plate_pressure_floor at
+  // some step so far (always true without plate_floor_once_reached).
+  bool plate_floor_reached() const { return plate_floor_reached_; }
 
   // Force of the fluid on body k (0: fixed walls, k: plates[k-1]) at the last step that
   // computed it: plates every step; the fixed walls only after request_body_forces() or
@@ -131,6 +135,8 @@ class FluidSolver {
   void update_owned_range();
   std::string describe_extremes() const;
   void check_leaks() const;
+  double lowest_plate_drive(double t) const;  // min over plates of prescribed + background (Pa)
+  void note_plate_floor(double t);
   PairFilter<D> pair_filter() const;
 
   struct Checkpoint;
@@ -150,6 +156,7 @@ class FluidSolver {
   long steps_ = 0;
   std::size_t lost_ = 0;
   std::size_t lost_density_ = 0;
+  bool plate_floor_reached_ = true;  // false from construction while a once-reached floor waits
   float max_speed_ = 0.0f;
   float max_acceleration_ = 0.0f;
   std::unique_ptr<ImmersedSurfaceModel<D>> surface_;

@@ -38,7 +38,9 @@ SPEED_BOUND_M_PER_S = 10.0
 PATTERNS = [  # (kind, regex on a log line), checked on error lines first
     ("nan", re.compile(r"\bnan\b|not finite|non-finite|infinit", re.IGNORECASE)),
     ("time-step collapse", re.compile(r"time step collapsed", re.IGNORECASE)),
-    ("solid failure", re.compile(r"inverted|overflow|material", re.IGNORECASE)),
+    # the solid's material errors (MaterialStateError: inverted element, exponent overflow, a
+    # non-positive eigenvalue); not the word 'material', which run folders' names carry
+    ("solid failure", re.compile(r"inverted|overflow|eigenvalue", re.IGNORECASE)),
     ("coupling divergence", re.compile(r"diverg|not converged", re.IGNORECASE)),
     # the coupler's runaway check (coupling.max_interface_speed, docs/coupling.md), and the
     # solid's own energy-growth stop (solid.max_energy_balance_error)

@@ -24,7 +24,7 @@ PRESETS = {
         # a session on a shared machine. The committed case (1 mm, 20 m/s) runs first, then the
         # finest, so that a sweep cut short has its reference; 0.575 mm (n = 40, ~2.4x the finest's
         # CPU) runs last, for the convergence in the spacing. n = 12 (1.917 mm) is left out: in
-        # session 4 every run at 1.917 and 1.4375 mm fluttered (17-32 m/s edges); n = 16 keeps one.
+        # the first sweep every run at 1.917 and 1.4375 mm fluttered (17-32 m/s edges); n = 16 keeps one.
         "runs": [{"group": "grid", "setting": {"spacing_mm": 23.0 / n, "sound_speed": c}}
                  for n, c in ((23, 20.0), (30, 40.0), (23, 10.0), (23, 40.0), (30, 20.0), (16, 20.0), (40, 40.0))],
         "finest": {"spacing_mm": 23.0 / 30, "sound_speed": 40.0},

@@ -286,6 +286,17 @@ class Classify(unittest.TestCase):
                 "[solid] stopping at t = 0.0196 s\n")
             ending = outcome.classify(run, 3, 0.06)
             self.assertEqual((ending.kind, ending.detected_by), ("energy growth", "solid"))
+            # a sweep's run folder is named by its setting ('material=MHGO,...'): the stop that
+            # names its folder is still energy growth, not a material failure
+            (run / "solid.log").write_text(
+                "[solid] solid: energy growth at t = 0.00183878 s, step 424: the energy balance error is 0.218; "
+                "the last sample of /work/runs/s/material=MHGO,leaflet_density=110/run hold this state\n")
+            ending = outcome.classify(run, 3, 0.06)
+            self.assertEqual((ending.kind, ending.detected_by), ("energy growth", "solid"))
+            (run / "solid.log").write_text(
+                "[solid] solid: solid at t = 0.011934 s, step 918: element 30: MHGO: in-plane det(C) = -0.01 <= 0 "
+                "(element inverted or degenerate)\n")
+            self.assertEqual(outcome.classify(run, 3, 0.06).kind, "solid failure")
             (run / "solid.log").write_text("")
             (run / "fluid.log").write_text(
                 "[fluid] fluid_sph: fluid leaks through the leaflets: 12 particle(s) found on the wrong side\n")

@@ -108,6 +108,11 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
     throw CaseError(fmt::format("{}: field 'solid.time_integration' = IMPLICIT with solid.element_family = "
                                 "HEXAHEDRON: allowed only for SHELL (no brick tangent yet)", source));
   }
+  if (solid.leaflet_self_contact() && (bricks || solid.disable_leaflet_contact())) {
+    throw CaseError(fmt::format("{}: field 'solid.leaflet_self_contact' = true with {}: allowed only for SHELL "
+                                "elements with leaflet contact on", source,
+                                bricks ? "solid.element_family = HEXAHEDRON" : "solid.disable_leaflet_contact = true"));
+  }
   if (!bricks && mesh.triangles.empty()) {
     throw CaseError(fmt::format("{}: solid.element_family = SHELL but {} has no /mesh/triangles", source, mesh_name));
   }
@@ -327,6 +332,14 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
                                       leaflets));
   } else if (solid.disable_leaflet_contact()) {
     setup.notes.push_back("leaflet-leaflet contact OFF (solid.disable_leaflet_contact)");
+  } else if (solid.leaflet_self_contact()) {
+    if (leaflets == 0) std::fill(surface_of_node.begin(), surface_of_node.end(), 0);
+    setup.notes.push_back(fmt::format("leaflet contact between {} leaflet(s) (node sets leaflet_k{}) and within each "
+                                      "(solid.leaflet_self_contact; neighbours within {:.3f} contact distances along "
+                                      "the surface skipped)", std::max(leaflets, 1),
+                                      leaflets == 0 ? "; none in the mesh: all nodes one leaflet" : "",
+                                      kSelfContactExclusion));
+    setup.solver->enable_leaflet_contact(std::move(surface_of_node), true);
   } else if (leaflets >= 2) {
     setup.notes.push_back(fmt::format("leaflet-leaflet contact between {} leaflets (node sets leaflet_k)", leaflets));
     setup.solver->enable_leaflet_contact(std::move(surface_of_node));

@@ -72,13 +72,13 @@ void ExplicitSolver::add_contact_plane(const Plane& plane) {
   internal_force_current_ = false;
 }
 
-void ExplicitSolver::enable_leaflet_contact(std::vector<int> surface_of_node) {
+void ExplicitSolver::enable_leaflet_contact(std::vector<int> surface_of_node, bool self_contact) {
   const ShellModel* surface = elements_->contact_surface();
   if (surface == nullptr) {
     throw std::invalid_argument(fmt::format("solid: leaflet-leaflet contact needs shell elements, not {}",
                                             elements_->family()));
   }
-  leaflet_contact_.emplace(*surface, std::move(surface_of_node));
+  leaflet_contact_.emplace(*surface, std::move(surface_of_node), self_contact);
   internal_force_current_ = false;
 }
 

@@ -43,8 +43,8 @@ Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen:
   return best_point;
 }
 
-LeafletContact::LeafletContact(const ShellModel& model, std::vector<int> surface_of_node)
-    : surface_of_node_(std::move(surface_of_node)) {
+LeafletContact::LeafletContact(const ShellModel& model, std::vector<int> surface_of_node, bool self_contact)
+    : surface_of_node_(std::move(surface_of_node)), self_contact_(self_contact) {
   const Eigen::Index n = model.reference_positions.cols();
   half_thickness_ = Eigen::VectorXd::Zero(n);
   double max_thickness = 0.0, max_reach = 0.0;
@@ -86,7 +86,15 @@ void LeafletContact::rebuild(const ShellModel& model, const Eigen::Matrix3Xd& x,
       if (nodes[0] == i || nodes[1] == i || nodes[2] == i) continue;
       if (!surface_of_node_.empty() &&
           surface_of_node_[static_cast<std::size_t>(nodes[0])] == surface_of_node_[static_cast<std::size_t>(i)]) {
-        continue;
+        if (!self_contact_) continue;
+        // Neighbours along the surface never touch (kSelfContactExclusion says why).
+        const auto& x0 = model.reference_positions;
+        const double reach = kSelfContactExclusion *
+                             (half_thickness_(i) + 0.5 * model.elements[static_cast<std::size_t>(e)].thickness);
+        Eigen::Vector3d w;
+        const Eigen::Vector3d c =
+            closest_point_on_triangle(x0.col(i), x0.col(nodes[0]), x0.col(nodes[1]), x0.col(nodes[2]), w);
+        if ((x0.col(i) - c).norm() < reach) continue;
       }
       pairs.emplace_back(static_cast<std::int32_t>(i), static_cast<std::int32_t>(e));
     }
@@ -103,27 +111,45 @@ std::int64_t LeafletContact::add_forces(const ShellModel& model, const Eigen::Ma
     rebuild(model, x, candidates);
   }
   std::int64_t in_contact = 0;
-  Eigen::Vector3d w;
+  Eigen::Vector3d w, direction;
   for (const auto& [i, e] : candidates.pairs) {
+    const double g = gap(model, x, i, e, direction, w);
+    if (g >= 0.0) continue;
     const ShellElement& el = model.elements[static_cast<std::size_t>(e)];
-    const Eigen::Vector3d p = x.col(i);
-    const Eigen::Vector3d c = closest_point_on_triangle(p, x.col(el.nodes[0]), x.col(el.nodes[1]), x.col(el.nodes[2]), w);
-    const Eigen::Vector3d separation = p - c;
-    const double distance = separation.norm();
-    const double gap = distance - (half_thickness_(i) + 0.5 * el.thickness);
-    if (gap >= 0.0) continue;
-    Eigen::Vector3d direction;
-    if (distance > 1e-9 * el.thickness) {
-      direction = separation / distance;
-    } else {  // on the mid-surface itself: push along the triangle's normal
-      direction = (x.col(el.nodes[1]) - x.col(el.nodes[0])).cross(x.col(el.nodes[2]) - x.col(el.nodes[0])).normalized();
-    }
-    const Eigen::Vector3d f = -stiffness_per_mass * model.nodal_mass(i) * gap * direction;
+    const Eigen::Vector3d f = -stiffness_per_mass * model.nodal_mass(i) * g * direction;
     forces.col(i) += f;
     for (int a = 0; a < 3; ++a) forces.col(el.nodes[a]) -= w(a) * f;
     ++in_contact;
   }
   return in_contact;
+}
+
+double LeafletContact::gap(const ShellModel& model, const Eigen::Matrix3Xd& x, std::int32_t i, std::int32_t e,
+                           Eigen::Vector3d& direction, Eigen::Vector3d& weights) const {
+  const ShellElement& el = model.elements[static_cast<std::size_t>(e)];
+  const Eigen::Vector3d p = x.col(i);
+  const Eigen::Vector3d c = closest_point_on_triangle(p, x.col(el.nodes[0]), x.col(el.nodes[1]), x.col(el.nodes[2]), weights);
+  const Eigen::Vector3d separation = p - c;
+  const double distance = separation.norm();
+  const double g = distance - (half_thickness_(i) + 0.5 * el.thickness);
+  if (g >= 0.0) return g;
+  if (distance > 1e-9 * el.thickness) {
+    direction = separation / distance;
+  } else {  // on the mid-surface itself: push along the triangle's normal
+    direction = (x.col(el.nodes[1]) - x.col(el.nodes[0])).cross(x.col(el.nodes[2]) - x.col(el.nodes[0])).normalized();
+  }
+  return g;
+}
+
+double LeafletContact::penalty_energy(const ShellModel& model, const Eigen::Matrix3Xd& x, double stiffness_per_mass,
+                                      const ContactCandidates& candidates) const {
+  double energy = 0.0;
+  Eigen::Vector3d w, direction;
+  for (const auto& [i, e] : candidates.pairs) {
+    const double g = gap(model, x, i, e, direction, w);
+    if (g < 0.0) energy += 0.5 * stiffness_per_mass * model.nodal_mass(i) * g * g;
+  }
+  return energy;
 }
 
 }  // namespace valvefsi::solid

@@ -68,6 +68,25 @@ TEST(CaseSetup, ImplicitTimeIntegrationIsReadAndRefusedForBricks) {
   }
 }
 
+TEST(CaseSetup, LeafletSelfContactIsReadAndRefusedForBricks) {
+  // The plate has no leaflet_<k> sets: with self-contact the whole mesh is one leaflet.
+  const CaseFiles f = write_case("self_contact", "leaflet_self_contact: true");
+  const SolidSetup setup = setup_from_case(load_case(f.case_file), f.case_file);
+  ASSERT_NE(setup.shell_solver().leaflet_contact(), nullptr);
+  EXPECT_TRUE(setup.shell_solver().leaflet_contact()->self_contact());
+  const CaseFiles plain = write_case("no_self_contact", "");
+  EXPECT_EQ(setup_from_case(load_case(plain.case_file), plain.case_file).shell_solver().leaflet_contact(), nullptr);
+  const CaseFiles bricks = write_case("self_contact_bricks", "leaflet_self_contact: true element_family: HEXAHEDRON");
+  try {
+    setup_from_case(load_case(bricks.case_file), bricks.case_file);
+    FAIL() << "bricks have no leaflet contact: self-contact must be refused";
+  } catch (const CaseError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("solid.leaflet_self_contact"), std::string::npos) << what;
+    EXPECT_NE(what.find("SHELL"), std::string::npos) << "names what is allowed: " << what;
+  }
+}
+
 TEST(CaseSetup, UnknownNodeSetIsNamed) {
   const CaseFiles f = write_case("bad", "fixed_node_sets: \"nope\"");
   const cases::Case c = load_case(f.case_file);

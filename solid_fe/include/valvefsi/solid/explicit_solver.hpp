@@ -174,8 +174,9 @@ class ExplicitSolver {
   // cross; the plane's normal points to the side where the leaflet lives. Penalty on nodes.
   void add_contact_plane(const Plane& plane);
   // Leaflet-leaflet contact between nodes and triangles of different surfaces (ids per node;
-  // empty: any non-incident triangle). Shell elements only (throws std::invalid_argument).
-  void enable_leaflet_contact(std::vector<int> surface_of_node);
+  // empty: any non-incident triangle), and with self_contact also within a surface beyond the
+  // neighbours along it (leaflet_contact.hpp). Shell elements only (throws std::invalid_argument).
+  void enable_leaflet_contact(std::vector<int> surface_of_node, bool self_contact = false);
   // Stent: penalty contact keeping every free node inside the cylinder by half its thickness.
   void add_contact_cylinder(const ContactCylinder& cylinder);
   // Plane-strain strip (2D runs): u_z = 0 on every node and each pair moves alike in x-y

@@ -26,22 +26,46 @@ struct ContactCandidates {
   std::int64_t rebuilds = 0;
 };
 
+// Self-contact skips a node-triangle pair of the same surface when, in the reference
+// configuration, the triangle lies within this many contact distances (t_node/2 + t_triangle/2)
+// of the node. Why pi/2: the tightest fold a shell of thickness t can make without its inner face
+// crossing itself has a mid-surface radius t/2, and points facing each other across it are a
+// half-turn, pi t/2, apart along the surface; any two mid-surface points closer than that along
+// a surface curved no tighter than t/2 are more than t apart in space (chord 2 rho sin(s/2 rho)
+// >= t for s >= pi t/2, rho >= t/2), so a flat or curved leaflet feels no self-contact, while a
+// fold brings pairs beyond this radius within t. A kink of a coarse mesh (curvature lumped at one
+// edge) turns by up to 2 acos(2/pi) = 101 degrees before a pair at this radius touches.
+inline constexpr double kSelfContactExclusion = 1.5707963267948966;
+
 class LeafletContact {
  public:
-  // surface_of_node: an id per node (e.g. its leaflet); pairs on the same surface are skipped.
-  // Empty: any triangle not touching the node may contact it.
-  LeafletContact(const ShellModel& model, std::vector<int> surface_of_node);
+  // surface_of_node: an id per node (e.g. its leaflet); pairs on the same surface are skipped
+  // unless self_contact, which keeps those farther apart than kSelfContactExclusion contact
+  // distances in the reference configuration. Empty: any triangle not touching the node may
+  // contact it.
+  LeafletContact(const ShellModel& model, std::vector<int> surface_of_node, bool self_contact = false);
+  bool self_contact() const { return self_contact_; }
 
   // Adds the penalty forces k * penetration (k = stiffness_per_mass * nodal mass) to `forces`,
   // rebuilding `candidates` when some node moved more than half the margin; returns the number
   // of node-triangle pairs in contact.
   std::int64_t add_forces(const ShellModel& model, const Eigen::Matrix3Xd& x, double stiffness_per_mass,
                           Eigen::Matrix3Xd& forces, ContactCandidates& candidates) const;
+  // Energy stored in the penalties at x over the current candidates: sum of k g^2 / 2 (J), the
+  // potential whose gradient add_forces applies (for the ledger's check).
+  double penalty_energy(const ShellModel& model, const Eigen::Matrix3Xd& x, double stiffness_per_mass,
+                        const ContactCandidates& candidates) const;
 
  private:
   void rebuild(const ShellModel& model, const Eigen::Matrix3Xd& x, ContactCandidates& candidates) const;
 
+  // Penetration (negative gap) of node i into triangle e at x, its direction and the closest
+  // point's barycentric weights; returns the gap (>= 0: apart).
+  double gap(const ShellModel& model, const Eigen::Matrix3Xd& x, std::int32_t i, std::int32_t e,
+             Eigen::Vector3d& direction, Eigen::Vector3d& weights) const;
+
   std::vector<int> surface_of_node_;
+  bool self_contact_ = false;
   Eigen::VectorXd half_thickness_;            // per node
   double margin_ = 0;
   double search_radius_ = 0;                  // largest centroid-to-vertex distance + contact gap

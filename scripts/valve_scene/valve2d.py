@@ -96,6 +96,21 @@ RESTART_INTERVAL_2D_S = 0.2
 # released them ~1,000-1,800 times per cycle and did not hold the valve shut, while it delayed the
 # FE-only opening (6.8 vs 3.7 ms) and broke the FE-only cycle-to-cycle agreement (11 % vs 2 %).
 COAPTATION_TIE = False
+# Session 8: the leaflet's self-contact (solid.leaflet_self_contact). In cycle 2 of the coarse
+# FSI-MHGO run leaflet A crumpled in the jet and passed through itself from 0.87 s (25 crossings
+# in 13 snapshots); a wall that crosses itself has no sides, and particles leaked there until the
+# leak stop (0.993 s). With the leaflet held apart from itself (session 7's per-column contact
+# sets) the same restart ran to 1.6 s with no crossing and no leak (docs/fsi-2d.md, sessions 7-8).
+# The FE-only cases carry it too (the same leaflet; their runs are unchanged, the solid's step
+# ~35 % dearer: docs/solid_fe.md, "Self-contact").
+LEAFLET_SELF_CONTACT_2D = True
+# Session 8: the ventricle's plate floor (fluid.plate_pressure_floor_mmHg with
+# plate_pressure_floor_once_reached): once the lower plate's drive has first risen to it (~55 ms
+# into the first systole), the lower plate is never driven below it, so the diastolic
+# ventricle's plate is pushed back to the blood instead of coasting away (docs/fsi-2d.md,
+# "Session 6"); before that the start is that of a case without floor (the plain floor from
+# t = 0 raised the leaflet force to 88 N/m in the first 10 ms against 1.2 N/m).
+PLATE_PRESSURE_FLOOR_2D_MMHG = 20.0
 COAPTATION_TIE_RELEASE_N_PER_M = 10.0
 # Contact plane holding the closed 2D valve (docs/fsi-2d.md).
 ANNULUS_PLANE = "annulus"
@@ -344,7 +359,11 @@ def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Chann
            "  background_pressure: 0",
            "  # the diastolic ventricle would run at -75 mmHg gauge and its plate pull away from the",
            "  # blood: both plates are raised together so the lower one stays at 0 (docs/fsi-2d.md)",
-           "  plates_never_pull: true"]),
+           "  plates_never_pull: true",
+           f"  # once the lower drive has reached it, the lower plate is held at {PLATE_PRESSURE_FLOOR_2D_MMHG:g} mmHg gauge (the",
+           "  # end-diastolic ventricle), so the diastolic ventricle's plate stays on the blood (valve2d.py)",
+           f"  plate_pressure_floor_mmHg: {PLATE_PRESSURE_FLOOR_2D_MMHG:g}",
+           "  plate_pressure_floor_once_reached: true"]),
         f"  domain_lower: {_vec([channel_start - margin, -half - margin])}",
         f"  domain_upper: {_vec([channel_end + margin, half + margin])}",
         f"  # the stent faces y = +-R lie on lattice planes (the channel walls {wall_offset * 1e3:.2g} mm off them)",
@@ -486,6 +505,8 @@ def case_text_2d(spec: Case2D) -> str:
              + strip_depth_line() + fe_only_settings + fsi_settings +
              "  fixed_node_sets: \"attachment\"\n"
              "  monitor_node_sets: \"free_edge_midpoints\"\n"
+             + ("  # a leaflet cannot pass through itself (a crumpled strip leaked through its own folds, valve2d.py)\n"
+                "  leaflet_self_contact: true\n" if LEAFLET_SELF_CONTACT_2D else "")
              + (f"  # the coapted tips stay on the annulus plane until pulled by {COAPTATION_TIE_RELEASE_N_PER_M:g} N/m (valve2d.py)\n"
                 f"  coaptation_tie {{ contact_plane: \"{ANNULUS_PLANE}\" release_force_N_per_m: {COAPTATION_TIE_RELEASE_N_PER_M:g} }}\n"
                 if COAPTATION_TIE else "") +

@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <numbers>
 #include <stdexcept>
 
 #include "valvefsi/fluid/fluid_solver.hpp"
@@ -102,6 +105,49 @@ TEST(ThinWallModel3D, ASectorsLeafletIsCopiedUnderTheWholeGroupOfItsPlanes) {
   }
 }
 
+// The quarter disk of the oscillating-disk proof under its two planes' group is the whole disk:
+// 4x the quarter's area, and the only free edge is the rim (the plane edges are shared).
+TEST(ThinWallModel3D, AQuarterDiskUnderItsPlanesIsTheWholeDisk) {
+  OscillatingDisk disk;
+  disk.quarter = true;
+  const double dp = disk.radius / 5;
+  const ThinWallCase3D c = oscillating_disk_box(dp, disk);
+  ASSERT_EQ(c.fluid.mirror_planes.size(), 2u);
+  const ThinWallModel3D model(c.surface, c.fluid, ThinWall3DSettings{});
+  const TriangleMesh& m = model.mesh();
+  auto area = [](const std::vector<Vec3>& x, const std::array<std::uint32_t, 3>& t) {
+    const Vec3 u{x[t[1]][0] - x[t[0]][0], x[t[1]][1] - x[t[0]][1], x[t[1]][2] - x[t[0]][2]};
+    const Vec3 v{x[t[2]][0] - x[t[0]][0], x[t[2]][1] - x[t[0]][1], x[t[2]][2] - x[t[0]][2]};
+    const Vec3 n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    return 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  };
+  double quarter = 0, whole = 0;
+  for (std::size_t t = 0; t < c.surface.cells.size(); t += 3)
+    quarter += area(c.surface.nodes, {c.surface.cells[t], c.surface.cells[t + 1], c.surface.cells[t + 2]});
+  for (const auto& t : m.triangles) whole += area(m.position, t);
+  EXPECT_NEAR(whole, 4.0 * quarter, 1e-12);
+  // a/dp = 5 rings: the rim is a polygon of 4 x 5 chords inscribed in the circle
+  const double sides = 20.0;
+  EXPECT_NEAR(whole, 0.5 * sides * disk.radius * disk.radius * std::sin(2.0 * std::numbers::pi / sides), 1e-12);
+  std::size_t rim = 0;
+  for (std::size_t k = 0; k < m.position.size(); ++k) {
+    const double r = std::hypot(m.position[k][1], m.position[k][2]);
+    if (m.vertex_on_boundary[k]) {
+      EXPECT_NEAR(r, disk.radius, 1e-12) << "node " << k << " is on the free boundary but inside the disk";
+      ++rim;
+    }
+  }
+  EXPECT_EQ(rim, 20u);
+  // Every side: a point in front of the disk at any angle is on side +1, behind it on -1.
+  for (const double phi : {0.3, 1.9, 3.5, 5.1}) {
+    const Vec3 front{-disk.amplitude + 0.01, 0.03 * std::cos(phi), 0.03 * std::sin(phi)};
+    const Vec3 back{-disk.amplitude - 0.01, 0.03 * std::cos(phi), 0.03 * std::sin(phi)};
+    EXPECT_EQ(closest_point(m, front).side, 1) << phi;
+    EXPECT_EQ(closest_point(m, back).side, -1) << phi;
+    EXPECT_FALSE(closest_point(m, front).on_boundary);
+  }
+}
+
 TEST(ThinWallModel3D, APairWithAMirrorImageIsBlockedByTheImageLeaflet) {
   for (const bool mirror : {false, true}) {
     auto s = settings(0.05);  // support 0.13 m
@@ -120,6 +166,41 @@ TEST(ThinWallModel3D, APairWithAMirrorImageIsBlockedByTheImageLeaflet) {
     EXPECT_EQ(model.blocked(1, 0, p), mirror);
     EXPECT_FALSE(model.blocked(0, 2, p));
   }
+}
+
+// Pair blocking (with its exact short cuts: the ends' distances and each candidate's distance
+// bound) agrees with the plain segment-mesh crossing for every pair within a support, on a
+// warped membrane with a free edge and particles scattered round it.
+TEST(ThinWallModel3D, BlockingAgreesWithTheExactCrossingOfEveryPair) {
+  const double dp = 0.05;
+  const auto s = settings(dp);
+  const double R = s.support_radius();
+  auto g = rectangle_mesh({0.5, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 0.6}, 12, 8);  // free edge at z = 0.6
+  for (auto& x : g.nodes) x[0] += 0.08 * std::sin(6.0 * x[1]) * std::cos(5.0 * x[2]);
+  ThinWallModel3D model(g, s, {});
+  Particles<3> p;
+  std::uint64_t state = 12345;
+  auto uniform = [&state] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  for (int k = 0; k < 700; ++k) p.add({0.3 + 0.4 * uniform(), 0.2 + 0.6 * uniform(), 0.3 + 0.5 * uniform()}, {0, 0, 0}, 0.0f, Kind::fluid);
+  model.classify(p);
+  std::size_t pairs = 0, crossing = 0, wrong = 0;
+  for (std::uint32_t a = 0; a < p.size(); ++a)
+    for (std::uint32_t b = 0; b < p.size(); ++b) {
+      if (a == b) continue;
+      const Vec3 xa{p.position[0][a], p.position[1][a], p.position[2][a]};
+      const Vec3 xb{p.position[0][b], p.position[1][b], p.position[2][b]};
+      if (std::hypot(xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]) >= R) continue;
+      const bool exact = first_crossing(model.mesh(), xa, xb).has_value();
+      ++pairs;
+      crossing += exact ? 1 : 0;
+      wrong += model.blocked(a, b, p) != exact ? 1 : 0;
+    }
+  std::printf("%zu pairs within a support, %zu crossing the membrane, %zu answered wrongly\n", pairs, crossing, wrong);
+  EXPECT_GT(crossing, 1000u);
+  EXPECT_EQ(wrong, 0u);
 }
 
 // A block of water round a 0.2 m membrane, 2 kPa on its left and 1 kPa on its right: every

@@ -274,6 +274,7 @@ int main(int argc, char** argv) {
   app.add_option("--amplitude", disk.amplitude, "disk amplitude A (m)");
   app.add_option("--period", disk.period, "disk period (s)");
   app.add_option("--box", disk.box, "disk box side (m)");
+  app.add_flag("--quarter", disk.quarter, "disk: the quarter y, z >= 0 with mirror planes y = 0 and z = 0 (force x4)");
   app.add_flag("--no-surface", no_surface, "run the same particles without the surface (cost reference)");
   app.add_option("--sample", sample_interval, "output interval (s)");
   app.add_option("--output", output, "CSV file of the time series");
@@ -291,6 +292,8 @@ int main(int argc, char** argv) {
   app.add_flag("--behind-only", behind_only, "virtual lattice behind the tangent plane only");
   app.add_option("--load-smoothing", smoothing_ratio, "with --case: node-load smoothing radius / dp (default: the case's)");
   app.add_flag("--aligned-layers", aligned, "virtual layers continue the particle's own lattice through the wall");
+  bool no_lattice_beyond_edge = false;
+  app.add_flag("--no-lattice-beyond-edge", no_lattice_beyond_edge, "no virtual lattice for particles beyond the free edge");
   CLI11_PARSE(app, argc, argv);
   if (!case_file.empty()) return run_case_at_rest(case_file, surface_file, steps, no_surface, aligned, behind_only, relax_cycles, relax_steps,
                                                    smoothing_ratio);
@@ -302,6 +305,7 @@ int main(int argc, char** argv) {
   c.wall_settings.virtual_spacing_ratio = lattice_ratio;
   c.wall_settings.particle_aligned_layers = aligned;
   c.wall_settings.lattice_in_front = !behind_only;
+  c.wall_settings.lattice_beyond_free_edge = !no_lattice_beyond_edge;
   std::ofstream csv;
   if (!output.empty()) {
     csv.open(output);

@@ -68,6 +68,50 @@ ImmersedSurfaceGeometry<3> disk_mesh(const Vec3& centre, double radius, double s
   return g;
 }
 
+ImmersedSurfaceGeometry<3> quarter_disk_mesh(const Vec3& centre, double radius, double spacing) {
+  ImmersedSurfaceGeometry<3> g;
+  g.nodes_per_cell = 3;
+  const int rings = std::max(1, static_cast<int>(std::lround(radius / spacing)));
+  g.nodes.push_back(centre);
+  std::vector<std::uint32_t> ring_start{0};
+  for (int k = 1; k <= rings; ++k) {
+    ring_start.push_back(static_cast<std::uint32_t>(g.nodes.size()));
+    const double r = radius * k / rings;
+    for (int j = 0; j <= k; ++j) {
+      const double phi = 0.5 * std::numbers::pi * j / k;
+      g.nodes.push_back({centre[0], centre[1] + r * std::cos(phi), centre[2] + r * std::sin(phi)});
+    }
+  }
+  // Between ring k - 1 (k nodes, the centre for k = 1) and ring k (k + 1 nodes): advance along
+  // whichever ring's next node comes first in angle.
+  for (int k = 1; k <= rings; ++k) {
+    const int n_in = k, n_out = k + 1;
+    auto inner = [&](int j) { return ring_start[static_cast<std::size_t>(k - 1)] + static_cast<std::uint32_t>(k == 1 ? 0 : j); };
+    auto outer = [&](int j) { return ring_start[static_cast<std::size_t>(k)] + static_cast<std::uint32_t>(j); };
+    auto angle_in = [&](int j) { return k == 1 ? 2.0 : static_cast<double>(j) / (k - 1); };
+    auto angle_out = [&](int j) { return static_cast<double>(j) / k; };
+    int i = 0, o = 0;
+    while (i < n_in - 1 || o < n_out - 1) {
+      if (o < n_out - 1 && (i >= n_in - 1 || angle_out(o + 1) <= angle_in(i + 1))) {
+        g.cells.insert(g.cells.end(), {inner(i), outer(o), outer(o + 1)});
+        ++o;
+      } else {
+        g.cells.insert(g.cells.end(), {inner(i), outer(o), inner(i + 1)});
+        ++i;
+      }
+    }
+  }
+  for (std::size_t t = 0; t < g.cells.size(); t += 3) {
+    const Vec3& a = g.nodes[g.cells[t]];
+    const Vec3& b = g.nodes[g.cells[t + 1]];
+    const Vec3& c = g.nodes[g.cells[t + 2]];
+    const double nx = (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]);
+    if (nx < 0) std::swap(g.cells[t + 1], g.cells[t + 2]);
+  }
+  g.node_thickness.assign(g.nodes.size(), 0.0);
+  return g;
+}
+
 ThinWallCase3D two_level_tank_3d(double dp, double left_level, double right_level, double width, double gap, bool mirror) {
   ThinWallCase3D c;
   auto& s = c.fluid;
@@ -109,11 +153,23 @@ ThinWallCase3D oscillating_disk_box(double dp, const OscillatingDisk& disk) {
   s.sound_speed = std::max(20.0 * speed, 40.0 * disk.box / disk.period);
   s.shifting = 1.0;
   const double L = disk.box;
-  s.domain_lower = {-0.7 * L, -0.7 * L, -0.7 * L};
-  s.domain_upper = {0.7 * L, 0.7 * L, 0.7 * L};
-  c.scene.walls.push_back(container_box<3>({-L / 2, -L / 2, -L / 2}, {L / 2, L / 2, L / 2}));
-  c.scene.fluid.push_back({{-L / 2, -L / 2, -L / 2}, {L / 2, L / 2, L / 2}, {}, [](const Vec<3>&) { return 0.0; }});
-  c.surface = disk_mesh({-disk.amplitude, 0.0, 0.0}, disk.radius, dp);
+  if (disk.quarter) {
+    // Walls on the far faces only; the planes y = 0 and z = 0 mirror the rest (and each
+    // other's images: the axis x is the rotation by pi about it).
+    s.domain_lower = {-0.7 * L, -4.0 * dp, -4.0 * dp};
+    s.domain_upper = {0.7 * L, 0.7 * L, 0.7 * L};
+    s.mirror_planes.push_back({{0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}});
+    s.mirror_planes.push_back({{0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}});
+    c.scene.walls.push_back(container_box<3>({-L / 2, -1e9, -1e9}, {L / 2, L / 2, L / 2}));
+    c.scene.fluid.push_back({{-L / 2, 0.0, 0.0}, {L / 2, L / 2, L / 2}, {}, [](const Vec<3>&) { return 0.0; }});
+    c.surface = quarter_disk_mesh({-disk.amplitude, 0.0, 0.0}, disk.radius, dp);
+  } else {
+    s.domain_lower = {-0.7 * L, -0.7 * L, -0.7 * L};
+    s.domain_upper = {0.7 * L, 0.7 * L, 0.7 * L};
+    c.scene.walls.push_back(container_box<3>({-L / 2, -L / 2, -L / 2}, {L / 2, L / 2, L / 2}));
+    c.scene.fluid.push_back({{-L / 2, -L / 2, -L / 2}, {L / 2, L / 2, L / 2}, {}, [](const Vec<3>&) { return 0.0; }});
+    c.surface = disk_mesh({-disk.amplitude, 0.0, 0.0}, disk.radius, dp);
+  }
   const std::vector<Vec3> rest = c.surface.nodes;
   const double A = disk.amplitude;
   c.motion = [rest, A, omega](double t, std::vector<Vec3>& x, std::vector<Vec3>& v) {

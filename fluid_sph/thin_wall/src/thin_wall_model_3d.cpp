@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -62,6 +63,24 @@ bool crosses_any(const TriangleMesh& mesh, const std::vector<std::uint32_t>& tri
                  const Vec3& q) {
   thread_local std::vector<std::uint32_t> one(1);
   for (const std::uint32_t t : triangles) {
+    const double sp = dot(normal[t], p) - offset[t], sq = dot(normal[t], q) - offset[t];
+    if (!may_meet(boxes[t], sp, sq, p, q)) continue;
+    one[0] = t;
+    if (first_crossing(mesh, one, p, q)) return true;
+  }
+  return false;
+}
+
+// The same over candidates sorted by their distance from p (`distances`, one per triangle, or
+// none: then all are tested): a triangle the segment meets lies within `reach` of p, so the scan
+// stops at the first farther one. Exact, the answer is that of crosses_any.
+bool crosses_any_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles, const std::vector<double>* distances,
+                        double reach, const std::vector<Vec3>& normal, const std::vector<double>& offset,
+                        const std::vector<std::array<Vec3, 2>>& boxes, const Vec3& p, const Vec3& q) {
+  if (distances == nullptr || distances->size() != triangles.size()) return crosses_any(mesh, triangles, normal, offset, boxes, p, q);
+  thread_local std::vector<std::uint32_t> one(1);
+  for (std::size_t k = 0; k < triangles.size() && (*distances)[k] <= reach; ++k) {
+    const std::uint32_t t = triangles[k];
     const double sp = dot(normal[t], p) - offset[t], sq = dot(normal[t], q) - offset[t];
     if (!may_meet(boxes[t], sp, sq, p, q)) continue;
     one[0] = t;
@@ -375,6 +394,7 @@ void ThinWallModel3D::classify(const Particles<3>& p) {
   const std::size_t n = p.size();
   s.near.assign(n, NearWall{});
   s.candidates.resize(n);
+  s.candidate_distance.resize(n);
   std::uint32_t max_id = 0;
   for (std::size_t i = 0; i < n; ++i) max_id = std::max(max_id, p.id[i]);
   if (s.side_by_id.size() <= max_id) s.side_by_id.resize(max_id + 1, 0);
@@ -396,7 +416,9 @@ void ThinWallModel3D::classify(const Particles<3>& p) {
     for (std::ptrdiff_t ii = 0; ii < count; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       auto& cand = s.candidates[i];
+      auto& cand_distance = s.candidate_distance[i];
       cand.clear();
+      cand_distance.clear();
       if (p.kind[i] == Kind::lost) continue;
       const std::uint32_t id = p.id[i];
       const Vec3 x = position_of(p, i);
@@ -404,7 +426,7 @@ void ThinWallModel3D::classify(const Particles<3>& p) {
       for (int d = 0; d < 3; ++d) outside = outside || x[d] < lo[d] || x[d] > hi[d];
       if (!outside) {
         buckets_.query({x[0] - R, x[1] - R, x[2] - R}, {x[0] + R, x[1] + R, x[2] + R}, boxed);
-        triangles_within(mesh_, boxed, x, R, cand);
+        triangles_within(mesh_, boxed, x, R, cand, cand_distance);
       }
       if (cand.empty()) {
         if (p.kind[i] == Kind::fluid) s.side_by_id[id] = 0;
@@ -438,7 +460,10 @@ bool ThinWallModel3D::blocked(std::uint32_t a, std::uint32_t b, const Particles<
   // than the sum of its ends' distances cannot reach the mesh.
   const double R = fluid_.support_radius();
   if (ab >= R || ab < near[a].closest.distance + near[b].closest.distance) return false;
-  return crosses_any(mesh_, dyn_.candidates[a], face_normal_, face_offset_, face_box_, xa, xb);
+  // A triangle met at m is within |am| of a while b is at least its distance d_b from the mesh
+  // away from m: only a's candidates within |ab| - d_b can be met (the margin covers rounding).
+  const double reach = ab - near[b].closest.distance + reach_margin();
+  return crosses_any_within(mesh_, dyn_.candidates[a], distances_of(a), reach, face_normal_, face_offset_, face_box_, xa, xb);
 }
 
 void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGrid<3>& grid) {
@@ -470,7 +495,10 @@ void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGri
           const int side = s.near[b].closest.side;
           // The node as seen from b's side: nothing of the mesh may lie in between.
           const Vec3 target{xm[0] + side * tiny * nm[0], xm[1] + side * tiny * nm[1], xm[2] + side * tiny * nm[2]};
-          if (crosses_any(mesh_, s.candidates[b], face_normal_, face_offset_, face_box_, xb, target)) continue;
+          const bool shifted = seg.shift[0] != 0 || seg.shift[1] != 0 || seg.shift[2] != 0;  // candidates are b's own
+          const double reach = shifted ? std::numeric_limits<double>::infinity() : norm(sub(target, xb)) + reach_margin();
+          if (crosses_any_within(mesh_, s.candidates[b], distances_of(b), reach, face_normal_, face_offset_, face_box_, xb, target))
+            continue;
           const double w = W.value(static_cast<float>(dist));
           const int k = side_index(side);
           const double rho_b = fluid_.rest_density + p.density_excess[b];
@@ -533,6 +561,7 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
         const auto a = static_cast<std::size_t>(aa);
         if (p.kind[a] != Kind::fluid || !s.near[a].near) continue;
         const auto& cand = s.candidates[a];
+        const std::vector<double>* cand_distance = distances_of(a);
         const Vec3 xa = position_of(p, a);
         side_a.resize(cand.size());
         for (std::size_t k = 0; k < cand.size(); ++k) side_a[k] = dot(face_normal_[cand[k]], xa) - face_offset_[cand[k]];
@@ -572,6 +601,7 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
         one.resize(1);
         for (std::size_t sheet = 0; sheet < sheets.size(); ++sheet) {
         const ClosestPoint3& c = sheets[sheet];
+        if (c.on_boundary && !settings_.lattice_beyond_free_edge) continue;
         const int only_piece = sheet == 0 ? -1 : sheet_of_triangle_[c.triangle];
         const int k_side = side_index(c.side);
         // Lattice axes: n from the closest point towards the particle (turns smoothly round a
@@ -616,7 +646,10 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
               // first, so the first hit is the one by the closest point (on a folded mesh
               // the segment may meet it twice; the nearer triangle is the one in between).
               std::optional<Crossing3> hit;
+              // Only candidates within |a x_v| of a can be met on the way (nearest first).
+              const double reach = cand_distance ? std::sqrt(r2) + reach_margin() : std::numeric_limits<double>::infinity();
               for (std::size_t k = 0; k < cand.size() && !hit; ++k) {
+                if (cand_distance && (*cand_distance)[k] > reach) break;
                 const std::uint32_t t = cand[k];
                 const double sv = dot(face_normal_[t], xv) - face_offset_[t];
                 if (!may_meet(face_box_[t], side_a[k], sv, xa, xv)) continue;
@@ -698,7 +731,8 @@ bool ThinWallModel3D::accept_shift(const Particles<3>& p, std::size_t i, const V
   if (i >= s.near.size() || !s.near[i].near) return true;
   const Vec3 x = position_of(p, i);
   const Vec3 y{x[0] + shift[0], x[1] + shift[1], x[2] + shift[2]};
-  bool ok = !crosses_any(mesh_, s.candidates[i], face_normal_, face_offset_, face_box_, x, y);
+  const double reach = std::sqrt(shift[0] * shift[0] + shift[1] * shift[1] + shift[2] * shift[2]) + reach_margin();
+  bool ok = !crosses_any_within(mesh_, s.candidates[i], distances_of(i), reach, face_normal_, face_offset_, face_box_, x, y);
   if (ok) {
     const double after = closest_point(mesh_, s.candidates[i], y).distance;
     ok = !(after < clearance_ && after < s.near[i].closest.distance);
@@ -814,6 +848,7 @@ void ThinWallModel3D::load_restart_state(std::span<const NamedArray> arrays) {
     c.on_boundary = e[10] != 0.0;
   }
   s.candidates = in.lists("particles.candidates", near.size());
+  s.candidate_distance.clear();  // not stored: the next classify rebuilds them (until then every candidate is tested)
   for (const auto& list : s.candidates)
     for (const auto t : list)
       if (t >= mesh_.triangles.size())

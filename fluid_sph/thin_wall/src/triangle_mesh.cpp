@@ -340,7 +340,14 @@ std::vector<std::array<Vec3, 2>> triangle_boxes(const TriangleMesh& mesh, const 
 
 void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& candidates, const Vec3& x, double radius,
                       std::vector<std::uint32_t>& out) {
+  thread_local std::vector<double> distances;
+  triangles_within(mesh, candidates, x, radius, out, distances);
+}
+
+void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& candidates, const Vec3& x, double radius,
+                      std::vector<std::uint32_t>& out, std::vector<double>& distances) {
   out.clear();
+  distances.clear();
   thread_local std::vector<std::pair<double, std::uint32_t>> found;
   found.clear();
   for (const std::uint32_t t : candidates) {
@@ -352,7 +359,10 @@ void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>
     if (d2 < radius * radius) found.push_back({d2, t});
   }
   std::sort(found.begin(), found.end());
-  for (const auto& [d2, t] : found) out.push_back(t);
+  for (const auto& [d2, t] : found) {
+    out.push_back(t);
+    distances.push_back(std::sqrt(d2));
+  }
 }
 
 }  // namespace valvefsi::fluid::thin_wall

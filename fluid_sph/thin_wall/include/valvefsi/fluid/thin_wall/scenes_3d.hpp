@@ -27,6 +27,9 @@ ImmersedSurfaceGeometry<3> rectangle_mesh(const Vec3& origin, const Vec3& u, con
 // A flat disk of the given radius about `centre` in the plane x = centre[0] (normal +x),
 // rings about `spacing` apart.
 ImmersedSurfaceGeometry<3> disk_mesh(const Vec3& centre, double radius, double spacing);
+// The quarter y >= 0, z >= 0 of such a disk: ring k has k + 1 nodes from the +y to the +z
+// axis, so its edges on the planes y = 0 and z = 0 carry nodes that the planes' images share.
+ImmersedSurfaceGeometry<3> quarter_disk_mesh(const Vec3& centre, double radius, double spacing);
 
 // A tank [0, 0.5] x [0, width] x [0, ...] of water, z up, split at x = 0.25 m by a thin
 // membrane (normal -x: side +1 is the left), water level left_level on the left and
@@ -45,6 +48,9 @@ struct OscillatingDisk {
   double period = 0.5;      // s
   double box = 0.3;         // L (m)
   double viscosity = 1e-3;  // Pa s
+  // Only the quarter y >= 0, z >= 0 with mirror planes at y = 0 and z = 0 (a quarter of the
+  // particles; the force on the whole disk is 4x the quarter's).
+  bool quarter = false;
 };
 ThinWallCase3D oscillating_disk_box(double dp, const OscillatingDisk& disk);
 

@@ -58,6 +58,10 @@ struct ThinWall3DSettings {
   // Radius (over dp, along the mesh) over which each node's load is spread before it goes to
   // the solid, conserving total force and moment (load_smoothing.hpp); 0: the raw loads.
   double load_smoothing_radius_ratio = 0.0;
+  // Experiment on the free edge's bias (docs/thin-leaflet.md, "Session 8"): false leaves out the
+  // virtual lattice of a particle whose closest point is on the free edge (beyond it), where the
+  // fluid hidden behind the leaflet really flows round the edge instead of moving with it.
+  bool lattice_beyond_free_edge = true;
 };
 
 // Consistent orientation of an open triangle mesh: flips triangles (per connected piece, from
@@ -132,6 +136,7 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
     std::vector<Vec3> force;    // per real node
     std::vector<NearWall> near;
     std::vector<std::vector<std::uint32_t>> candidates;
+    std::vector<std::vector<double>> candidate_distance;  // per particle: its candidates' distances (ascending)
     std::vector<std::int8_t> side_by_id;
     std::vector<std::uint8_t> corrected_by_id;
     std::vector<Vec3> previous_by_id;
@@ -141,6 +146,15 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
   };
 
   void place_mesh();  // mesh_ (with images) from dyn_.x, v, a
+  // Particle i's candidates' distances, or nullptr when they are not known (after a restart
+  // until the next classify): callers then test every candidate.
+  const std::vector<double>* distances_of(std::size_t i) const {
+    const auto& d = dyn_.candidate_distance;
+    return i < d.size() && d[i].size() == dyn_.candidates[i].size() ? &d[i] : nullptr;
+  }
+  // Slack on a distance bound for rounding (the triangle test's touching tolerance is 1e-12 of
+  // a triangle): far below any distance the model resolves.
+  double reach_margin() const { return 1e-6 * fluid_.particle_spacing; }
   // Real node of mesh node k.
   std::uint32_t real_node(std::uint32_t k) const { return origin_node_[k]; }
   // A real vector seen at the image under map m (-1: none), and back.

@@ -106,5 +106,9 @@ std::vector<std::array<Vec3, 2>> triangle_boxes(const TriangleMesh& mesh, const 
 // nearest first (queries that stop at the first hit then test the likely one first).
 void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& candidates, const Vec3& x, double radius,
                       std::vector<std::uint32_t>& out);
+// The same, with each found triangle's distance from x in `distances` (ascending, as `out`):
+// a segment from x of length L can only meet the triangles with distance <= L.
+void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& candidates, const Vec3& x, double radius,
+                      std::vector<std::uint32_t>& out, std::vector<double>& distances);
 
 }  // namespace valvefsi::fluid::thin_wall

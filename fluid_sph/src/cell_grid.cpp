@@ -49,30 +49,32 @@ void CellGrid<D>::set_cell_starts(std::vector<std::uint32_t> starts) {
 }
 
 template <int D>
+bool CellGrid<D>::wrap_or_mark_lost(Particles<D>& p, std::size_t i) const {
+  if (p.kind[i] == Kind::lost) return false;
+  bool inside = true;
+  for (int d = 0; d < D; ++d) {
+    double& x = p.position[d][i];
+    if (!std::isfinite(x)) {
+      inside = false;
+    } else if (periodic_[d]) {
+      const double length = upper_[d] - lower_[d];
+      if (x < lower_[d]) x += length * std::ceil((lower_[d] - x) / length);
+      if (x >= upper_[d]) x -= length * std::floor((x - lower_[d]) / length);
+    } else if (x < lower_[d] || x >= upper_[d]) {
+      inside = false;
+    }
+  }
+  if (inside) return false;
+  p.kind[i] = Kind::lost;
+  return true;
+}
+
+template <int D>
 std::size_t CellGrid<D>::wrap_and_mark_lost(Particles<D>& p) const {
   const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(p.size());
   std::size_t newly_lost = 0;
 #pragma omp parallel for reduction(+ : newly_lost) schedule(static)
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    if (p.kind[i] == Kind::lost) continue;
-    bool inside = true;
-    for (int d = 0; d < D; ++d) {
-      double& x = p.position[d][i];
-      if (!std::isfinite(x)) {
-        inside = false;
-      } else if (periodic_[d]) {
-        const double length = upper_[d] - lower_[d];
-        if (x < lower_[d]) x += length * std::ceil((lower_[d] - x) / length);
-        if (x >= upper_[d]) x -= length * std::floor((x - lower_[d]) / length);
-      } else if (x < lower_[d] || x >= upper_[d]) {
-        inside = false;
-      }
-    }
-    if (!inside) {
-      p.kind[i] = Kind::lost;
-      ++newly_lost;
-    }
-  }
+  for (std::ptrdiff_t i = 0; i < n; ++i) newly_lost += wrap_or_mark_lost(p, static_cast<std::size_t>(i)) ? 1 : 0;
   return newly_lost;
 }
 

@@ -357,8 +357,13 @@ void FluidSolver<D>::step() {
   auto first = static_cast<std::ptrdiff_t>(owned_begin_), last = static_cast<std::ptrdiff_t>(owned_end_);
   if (surface_) surface_->begin_step(p);
 
+  // Only the fluid moves and nothing else moves it before the wrap (no plates, images, surface
+  // or slabs): each particle is wrapped or marked lost right after its drift, in the same pass.
+  const bool wrap_in_drift = plates_.empty() && settings_.mirror_planes.empty() && !surface_ && !slabs_;
+  std::size_t lost_in_drift = 0;
+
   // First kick (velocity half step, density predicted to the full step) and drift (eq. 4).
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) reduction(+ : lost_in_drift)
   for (std::ptrdiff_t i = first; i < last; ++i) {
     if (p.kind[i] != Kind::fluid) continue;
     for (int d = 0; d < D; ++d) {
@@ -368,6 +373,7 @@ void FluidSolver<D>::step() {
     }
     p.density_excess[i] += full * p.density_rate[i];
     p.density_rate_previous[i] = p.density_rate[i];
+    if (wrap_in_drift && grid_.wrap_or_mark_lost(p, static_cast<std::size_t>(i))) ++lost_in_drift;
   }
   for (auto& plate : plates_) {
     plate.velocity += 0.5 * dt * plate.acceleration;
@@ -399,6 +405,8 @@ void FluidSolver<D>::step() {
     slabs_->migrate_and_share_halo(p);
     add_mirror_images();
     lost_ += static_cast<std::size_t>(slabs_->sum(newly_lost));
+  } else if (wrap_in_drift) {
+    lost_ += lost_in_drift;
   } else {
     refresh_mirror_images();
     lost_ += grid_.wrap_and_mark_lost(p);

@@ -240,6 +240,19 @@ using LaneBatch = xsimd::batch<float>;
 constexpr int kBatch = static_cast<int>(LaneBatch::size);
 static_assert(kBlock % kBatch == 0, "a lane block must be a whole number of vectors");
 
+// The offset from a broadcast neighbour at (bx, by, bz) to the lanes of vector c of x, and its
+// squared length: the start of every register sweep's pair term.
+struct LaneOffset {
+  LaneBatch dx, dy, dz, r2;
+};
+template <int D, int C>
+[[gnu::always_inline]] inline LaneOffset lane_offset(const LaneBatch (&x)[3][C], int c, float bx, float by, float bz) {
+  LaneOffset o{x[0][c] - bx, x[1][c] - by, D == 3 ? x[D - 1][c] - bz : LaneBatch(0.0f), LaneBatch(0.0f)};
+  o.r2 = o.dx * o.dx + o.dy * o.dy;
+  if constexpr (D == 3) o.r2 += o.dz * o.dz;
+  return o;
+}
+
 // The kernels of kernels.hpp on a vector of distances (same arithmetic as the scalar ones).
 template <int D>
 inline LaneBatch gradient_factor(const WendlandC2Kernel<D>& W, const LaneBatch& r) {
@@ -292,9 +305,10 @@ struct NeighbourLists {
 // sums held in registers (C vectors of lanes) for the length of the list: no per-pair load and
 // store of the per-lane sums. acc: where the list's accelerations are summed (the block's own
 // sums, or a body's booking). Viscous: false when mu = 0 (the term is then exactly zero).
-template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Viscous, int C, class Kernel>
-inline void sweep_neighbours(LaneBlock& L, const Neighbour* nb, std::size_t count, float (*acc)[kBlock],
-                             const PairConstants<D>& k, const Kernel& W) {
+// source(take) calls take(neighbour) for every neighbour in order (a list, or the segments).
+template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Viscous, int C, class Kernel, class Source>
+[[gnu::always_inline]] inline void sweep_neighbours(LaneBlock& L, Source&& source, float (*acc)[kBlock], const PairConstants<D>& k,
+                                                    const Kernel& W) {
   using B = LaneBatch;
   constexpr int S = kBatch;
   B x[3][C], v[3][C], w[3][C], p_wall[C], p_rest[C], inv[C], ex[C];
@@ -318,13 +332,9 @@ inline void sweep_neighbours(LaneBlock& L, const Neighbour* nb, std::size_t coun
     diff[c] = B::load_aligned(&L.diff[o]);
     if constexpr (WithKernelSum) csum[c] = B::load_aligned(&L.csum[o]);
   }
-  for (std::size_t j = 0; j < count; ++j) {
-    const Neighbour& b = nb[j];
+  source([&](const Neighbour& b) {
     for (int c = 0; c < C; ++c) {
-      const B dx = x[0][c] - b.x, dy = x[1][c] - b.y;
-      const B dz = D == 3 ? x[D - 1][c] - b.z : B(0.0f);
-      B r2 = dx * dx + dy * dy;
-      if constexpr (D == 3) r2 += dz * dz;
+      const auto [dx, dy, dz, r2] = lane_offset<D>(x, c, b.x, b.y, b.z);
       const B r = xsimd::sqrt(r2);
       const B F = gradient_factor(W, r);
       const B inv_rr = inv[c] * b.inv;
@@ -357,7 +367,7 @@ inline void sweep_neighbours(LaneBlock& L, const Neighbour* nb, std::size_t coun
         if constexpr (D == 3) cg[D - 1][c] += F * dz * b.inv;
       }
     }
-  }
+  });
   for (int c = 0; c < C; ++c) {
     const int o = c * S;
     for (int d = 0; d < D; ++d) {
@@ -371,13 +381,13 @@ inline void sweep_neighbours(LaneBlock& L, const Neighbour* nb, std::size_t coun
 }
 
 // sweep_neighbours with C = the number of vectors the block's n lanes fill (1 .. kBlock/kBatch).
-template <int D, bool AV, bool KS, bool Viscous, int C = kBlock / kBatch, class Kernel>
-inline void sweep_lanes(int n, LaneBlock& L, const Neighbour* list, std::size_t count, float (*acc)[kBlock],
-                        const PairConstants<D>& k, const Kernel& W) {
+template <int D, bool AV, bool KS, bool Viscous, int C = kBlock / kBatch, class Kernel, class Source>
+inline void sweep_lanes(int n, LaneBlock& L, const Source& source, float (*acc)[kBlock], const PairConstants<D>& k,
+                        const Kernel& W) {
   if constexpr (C > 1) {
-    if (n <= (C - 1) * kBatch) return sweep_lanes<D, AV, KS, Viscous, C - 1>(n, L, list, count, acc, k, W);
+    if (n <= (C - 1) * kBatch) return sweep_lanes<D, AV, KS, Viscous, C - 1>(n, L, source, acc, k, W);
   }
-  sweep_neighbours<D, AV, KS, Viscous, C>(L, list, count, acc, k, W);
+  sweep_neighbours<D, AV, KS, Viscous, C>(L, source, acc, k, W);
 }
 
 // Bounding box of a block's lanes. A neighbour farther than a support from it meets no lane,
@@ -457,24 +467,45 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
     unsigned booked_bodies = 0;  // bit k: body k got a pair this block
     float box_lo[3] = {0, 0, 0}, box_hi[3] = {0, 0, 0};
     lane_box<D>(L.x, n, box_lo, box_hi);
-    // take(b, nb) for every particle of the segments (shifted across periodic sides) within a
-    // support of the lanes' box, in segment order: both paths below see the same neighbours.
+    // Particle b of a segment shifted by `shift` (across periodic sides), as broadcast.
+    auto neighbour = [&](std::uint32_t b, const float (&shift)[3]) {
+      return Neighbour{p.x[0][b] + shift[0], p.x[1][b] + shift[1], D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f,
+                       p.v[0][b], p.v[1][b], D == 3 ? p.v[D - 1][b] : 0.0f,
+                       p.vv[0][b], p.vv[1][b], D == 3 ? p.vv[D - 1][b] : 0.0f,
+                       p.pressure[b], p.inverse_density[b], p.excess[b], p.fluid[b]};
+    };
+    // every_candidate(take) calls take(b, nb) for every particle of the segments, in segment
+    // order; for_each_candidate only for those within a support of the lanes' box (the others
+    // add exact zeros): both paths below see the same neighbours.
+    auto every_candidate = [&](auto&& take) {
+      for (int sidx = 0; sidx < segment_count; ++sidx) {
+        const auto& seg = segments[sidx];
+        float shift[3] = {0, 0, 0};
+        for (int d = 0; d < D; ++d) shift[d] = static_cast<float>(seg.shift[d]);
+        for (std::uint32_t b = seg.begin; b < seg.end; ++b) take(b, neighbour(b, shift));
+      }
+    };
     auto for_each_candidate = [&](auto&& take) {
       for (int sidx = 0; sidx < segment_count; ++sidx) {
         const auto& seg = segments[sidx];
         float shift[3] = {0, 0, 0};
         for (int d = 0; d < D; ++d) shift[d] = static_cast<float>(seg.shift[d]);
         for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
-          const float nb_x[3] = {p.x[0][b] + shift[0], p.x[1][b] + shift[1], D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f};
-          if (!near_box<D>(box_lo, box_hi, nb_x[0], nb_x[1], nb_x[2], k.support2)) continue;
-          take(b, Neighbour{nb_x[0], nb_x[1], nb_x[2],
-                            p.v[0][b], p.v[1][b], D == 3 ? p.v[D - 1][b] : 0.0f,
-                            p.vv[0][b], p.vv[1][b], D == 3 ? p.vv[D - 1][b] : 0.0f,
-                            p.pressure[b], p.inverse_density[b], p.excess[b], p.fluid[b]});
+          const float y = p.x[1][b] + shift[1], z = D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f;
+          if (near_box<D>(box_lo, box_hi, p.x[0][b] + shift[0], y, z, k.support2)) take(b, neighbour(b, shift));
         }
       }
     };
-    if constexpr (!Masked) {
+    auto sweep = [&](const auto& source, float (*acc)[kBlock]) {
+      if (k.two_mu != 0.0f) sweep_lanes<D, WithArtificialViscosity, WithKernelSum, true>(n, L, source, acc, k, W);
+      else sweep_lanes<D, WithArtificialViscosity, WithKernelSum, false>(n, L, source, acc, k, W);
+    };
+    if constexpr (!Masked && !Bodies && D == 2) {
+      // 2D without bodies: the box test keeps ~92 % of the candidates, so the segments are
+      // swept in place (no test, no list). The neighbours and their order are those of the
+      // list path; the candidates it would drop add exact zeros (F = 0 beyond the support).
+      sweep([&](auto&& take) { every_candidate([&](std::uint32_t, const Neighbour& nb) { take(nb); }); }, L.acc);
+    } else if constexpr (!Masked) {
       // Register path: collect the neighbours that pass the box test, then sweep each list
       // once over all lanes. Per lane the terms are summed in neighbour order, plain ones
       // first, then each booked body's, whatever the block: the sums do not depend on how
@@ -498,17 +529,18 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
         }
         plain[plain_count++] = nb;
       });
-      auto sweep = [&](const Neighbour* list, std::size_t count, float (*acc)[kBlock]) {
-        if (k.two_mu != 0.0f) sweep_lanes<D, WithArtificialViscosity, WithKernelSum, true>(n, L, list, count, acc, k, W);
-        else sweep_lanes<D, WithArtificialViscosity, WithKernelSum, false>(n, L, list, count, acc, k, W);
+      auto list = [](const Neighbour* nb, std::size_t count) {
+        return [nb, count](auto&& take) {
+          for (std::size_t j = 0; j < count; ++j) take(nb[j]);
+        };
       };
-      sweep(plain, plain_count, L.acc);
+      sweep(list(plain, plain_count), L.acc);
       if constexpr (Bodies) {
         for (unsigned body = 0; booked_bodies >> body; ++body) {
           if (!(booked_bodies & (1u << body))) continue;
           for (int d = 0; d < 3; ++d)
             for (int i = 0; i < kBlock; ++i) L.booked[body][d][i] = 0.0f;
-          sweep(lists.booked[body].data(), lists.booked_count[body], L.booked[body]);
+          sweep(list(lists.booked[body].data(), lists.booked_count[body]), L.booked[body]);
           for (int d = 0; d < D; ++d)
             for (int i = 0; i < n; ++i) L.acc[d][i] += L.booked[body][d][i];
         }
@@ -597,10 +629,7 @@ inline void sweep_wall_neighbours(WallLanes& L, const WallNeighbour* nb, std::si
   for (std::size_t j = 0; j < count; ++j) {
     const WallNeighbour& b = nb[j];
     for (int c = 0; c < C; ++c) {
-      const B dx = x[0][c] - b.x, dy = x[1][c] - b.y;
-      const B dz = D == 3 ? x[D - 1][c] - b.z : B(0.0f);
-      B r2 = dx * dx + dy * dy;
-      if constexpr (D == 3) r2 += dz * dz;
+      const auto [dx, dy, dz, r2] = lane_offset<D>(x, c, b.x, b.y, b.z);
       const B wk = kernel_value(W, xsimd::sqrt(r2));
       sum_w[c] += wk;
       sum_p[c] += b.p * wk;

@@ -36,6 +36,8 @@ class CellGrid {
   // Wraps positions on periodic axes into [lower, upper) and marks particles outside a
   // non-periodic axis (or not finite) as Kind::lost. Returns how many became lost now.
   std::size_t wrap_and_mark_lost(Particles<D>& particles) const;
+  // The same for particle i alone (true if it became lost now), for passes that move it.
+  bool wrap_or_mark_lost(Particles<D>& particles, std::size_t i) const;
 
   // Stable counting sort of the particle arrays a sort carries (Particles::for_each_sorted_array_with)
   // by cell; lost particles go to the end. Sets the pair loops' scratch and, for fluid, the

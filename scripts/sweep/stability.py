@@ -81,7 +81,7 @@ def markdown(results: list[dict], order: list | None = None) -> str:
             o = r["outcome"]
             shown = ", ".join(f"{k} = {v}" for k, v in r["setting"].items() if k != "material")
             # what failed (the start) and what to change (the end) both stay
-            detail = outcome.shortened(re.sub(r"^(\[[^\]]*\]\s*)+", "", (o["detail"] or "")).replace("|", "/"), 320)
+            detail = outcome.shortened(re.sub(r"^(\[[^\]]*\]\s*)+", "", (o["detail"] or "")).replace("|", "/"), 440)
             reached = "–" if o["reached_s"] is None else f"{o['reached_s'] * 1e3:.1f}"
             lines.append(f"| {group} | {shown or 'default'} | {mu_of(r['setting']):.2g} | "
                          f"{float(s['spacing_mm']) / float(s['thickness_mm']):.0f} | {o['kind']} | {reached} | "

@@ -3,8 +3,25 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 namespace valvefsi::fluid::thin_wall {
+
+namespace {
+// A disk in a plane x = const: every triangle's normal along +x, zero thickness (the scenes'
+// plates are sheets).
+ImmersedSurfaceGeometry<3> oriented_along_plus_x(ImmersedSurfaceGeometry<3> g) {
+  for (std::size_t t = 0; t < g.cells.size(); t += 3) {
+    const Vec3& a = g.nodes[g.cells[t]];
+    const Vec3& b = g.nodes[g.cells[t + 1]];
+    const Vec3& c = g.nodes[g.cells[t + 2]];
+    const double nx = (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]);
+    if (nx < 0) std::swap(g.cells[t + 1], g.cells[t + 2]);
+  }
+  g.node_thickness.assign(g.nodes.size(), 0.0);
+  return g;
+}
+}  // namespace
 
 ImmersedSurfaceGeometry<3> rectangle_mesh(const Vec3& origin, const Vec3& u, const Vec3& v, int nu, int nv) {
   ImmersedSurfaceGeometry<3> g;
@@ -56,16 +73,7 @@ ImmersedSurfaceGeometry<3> disk_mesh(const Vec3& centre, double radius, double s
       }
     }
   }
-  // Orient every triangle with its normal along +x.
-  for (std::size_t t = 0; t < g.cells.size(); t += 3) {
-    const Vec3& a = g.nodes[g.cells[t]];
-    const Vec3& b = g.nodes[g.cells[t + 1]];
-    const Vec3& c = g.nodes[g.cells[t + 2]];
-    const double nx = (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]);
-    if (nx < 0) std::swap(g.cells[t + 1], g.cells[t + 2]);
-  }
-  g.node_thickness.assign(g.nodes.size(), 0.0);
-  return g;
+  return oriented_along_plus_x(std::move(g));
 }
 
 ImmersedSurfaceGeometry<3> quarter_disk_mesh(const Vec3& centre, double radius, double spacing) {
@@ -101,15 +109,7 @@ ImmersedSurfaceGeometry<3> quarter_disk_mesh(const Vec3& centre, double radius, 
       }
     }
   }
-  for (std::size_t t = 0; t < g.cells.size(); t += 3) {
-    const Vec3& a = g.nodes[g.cells[t]];
-    const Vec3& b = g.nodes[g.cells[t + 1]];
-    const Vec3& c = g.nodes[g.cells[t + 2]];
-    const double nx = (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]);
-    if (nx < 0) std::swap(g.cells[t + 1], g.cells[t + 2]);
-  }
-  g.node_thickness.assign(g.nodes.size(), 0.0);
-  return g;
+  return oriented_along_plus_x(std::move(g));
 }
 
 ThinWallCase3D two_level_tank_3d(double dp, double left_level, double right_level, double width, double gap, bool mirror) {

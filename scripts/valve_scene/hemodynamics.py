@@ -135,6 +135,7 @@ class CycleHemodynamics:
     series_end_s: float | None = None              # partial cycle: the series ends here (s in the cycle);
                                                    # leakage, regurgitant volume and the diastolic force
                                                    # then cover only [t2, series_end_s]
+    symmetry_factor: float = 1.0                   # the flows and forces above are the part's x this
 
 
 def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "downstream_tap",
@@ -349,7 +350,7 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
         pull_out_force=pull_out, diastolic_force=diastolic, diastolic_force_time_s=diastolic_time,
         hydrostatic_force=hydrostatic_force, water_hammer_ratio=ratio, section_stroke_volumes=sections,
         pspd_probe_mmHg=pspd_probe, peak_particle_speed=particle_speed,
-        series_end_s=float(t[-1] - start) if partial else None)
+        series_end_s=float(t[-1] - start) if partial else None, symmetry_factor=symmetry_factor)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -412,6 +413,20 @@ def hemodynamics_table(results: dict) -> str:
     return "\n".join(rows) + "\n"
 
 
+def plotted_flow_and_force(series: ProbeSeries, result: CycleHemodynamics, period: float = waveform.PERIOD_S):
+    """The plot's flow (mL/s; 2D cm^2/s) on the probe times of the cycle and its axial force
+    (times in ms from the cycle's start, N; 2D N/m), both of the whole valve: a sector's are
+    multiplied by the result's symmetry factor, as the table's are."""
+    start = (result.cycle - 1) * period
+    sel = (series.time >= start) & (series.time <= start + period)
+    to_volume = 1e6 if series.dimension == 3 else 1e4
+    flow = series.mean_flow_rate[sel] * to_volume * result.symmetry_factor
+    if series.axial_force is None or series.force_time is None:
+        return flow, None, None
+    fs = (series.force_time >= start) & (series.force_time <= start + period)
+    return flow, (series.force_time[fs] - start) * 1e3, series.axial_force[fs] * result.symmetry_factor
+
+
 def plot_cycle(series: ProbeSeries, result: CycleHemodynamics, path: Path, period: float = waveform.PERIOD_S) -> None:
     """Like the reference's Fig. 11: pressure drop, flow rate, axial leaflet force and maximum
     velocity over the analysed cycle."""
@@ -422,15 +437,14 @@ def plot_cycle(series: ProbeSeries, result: CycleHemodynamics, path: Path, perio
     sel = (series.time >= start) & (series.time <= start + period)
     t = (series.time[sel] - start) * 1e3
     u = _units(series.dimension)
-    to_volume = 1e6 if series.dimension == 3 else 1e4
+    flow, force_time, force = plotted_flow_and_force(series, result, period)
     fig, axes = plt.subplots(4, 1, figsize=(7, 9), sharex=True)
     axes[0].plot(t, series.pressure_drop[sel] / PA_PER_MMHG, "k-", lw=0.8)
     axes[0].set_ylabel("ΔP (mmHg)")
-    axes[1].plot(t, series.mean_flow_rate[sel] * to_volume, "b-", lw=0.8)
+    axes[1].plot(t, flow, "b-", lw=0.8)
     axes[1].set_ylabel(f"Q ({u['flow']})")
-    if series.axial_force is not None:
-        fs = (series.force_time >= start) & (series.force_time <= start + period)
-        axes[2].plot((series.force_time[fs] - start) * 1e3, series.axial_force[fs], "r-", lw=0.8)
+    if force is not None:
+        axes[2].plot(force_time, force, "r-", lw=0.8)
         axes[2].axhline(result.hydrostatic_force, color="0.5", ls="--", lw=0.8, label="hydrostatic Pmax·A")
         axes[2].legend(fontsize=8)
     axes[2].set_ylabel(f"axial force ({u['force']})")

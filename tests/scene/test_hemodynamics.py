@@ -190,6 +190,12 @@ class Sector(unittest.TestCase):
         b = hd.analyse_cycle(sector, smoothing_s=0.0, symmetry_factor=6)
         for name in ("q_rms", "eoa", "regurgitant_volume", "pull_out_force", "diastolic_force", "water_hammer_ratio", "mspd_mmHg"):
             self.assertAlmostEqual(getattr(a, name), getattr(b, name), delta=1e-9 * max(1, abs(getattr(a, name))), msg=name)
+        # the plot shows the valve's flow and force too, not the sector's
+        qa, ta, fa = hd.plotted_flow_and_force(full, a)
+        qb, tb, fb = hd.plotted_flow_and_force(sector, b)
+        np.testing.assert_allclose(qb, qa, rtol=1e-12)
+        np.testing.assert_allclose(tb, ta)
+        np.testing.assert_allclose(fb, fa, rtol=1e-12)
 
 
 class TwoDimensional(unittest.TestCase):

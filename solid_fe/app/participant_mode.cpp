@@ -89,10 +89,10 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
   SolidSetup setup = setup_from_case(c, case_file);
   for (const auto& note : setup.notes) spdlog::info("{}", note);
   ExplicitSolver& solver = *setup.solver;
-  if (solver.implicit()) {
+  if (solver.options().time_integration != TimeIntegration::explicit_central_difference) {
     // Not yet tested against the coupler (checkpoints, restarts, 13 us windows): FE-only only.
-    spdlog::error("{}: field 'solid.time_integration' = IMPLICIT in a coupled run: allowed only with --fe-only "
-                  "(coupled runs use EXPLICIT)", case_file.string());
+    spdlog::error("{}: field 'solid.time_integration' = {} in a coupled run: allowed only with --fe-only "
+                  "(coupled runs use EXPLICIT)", case_file.string(), solver.automatic() ? "AUTOMATIC" : "IMPLICIT");
     return 2;
   }
   const SolidInterface interface =

@@ -95,6 +95,7 @@ int run_fe_only(const valvefsi::cases::Case& c, const std::filesystem::path& cas
         const auto folder = valvefsi::coupling::restart_folder(output_dir, t);
         std::filesystem::create_directories(folder);
         write_solver_restart(solver, valvefsi::coupling::restart_file_path(folder, "solid"));
+        solver.drop_kept_tangent();  // as the run continued from this file will (bit for bit)
         valvefsi::coupling::mark_restart_complete(folder, c.solid().restart_keep());
         ++next_restart;
       }

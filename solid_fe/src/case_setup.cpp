@@ -104,9 +104,11 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   const std::string mesh_name = setup.mesh_file.string();
   const bool bricks = solid.element_family() == cases::SolidCase::HEXAHEDRON;
   setup.element_family = bricks ? ElementFamily::hexahedron : ElementFamily::shell;
-  if (bricks && solid.time_integration() == cases::SolidCase::IMPLICIT) {
-    throw CaseError(fmt::format("{}: field 'solid.time_integration' = IMPLICIT with solid.element_family = "
-                                "HEXAHEDRON: allowed only for SHELL (no brick tangent yet)", source));
+  const bool implicit = solid.time_integration() != cases::SolidCase::EXPLICIT;
+  const std::string integration = cases::SolidCase::TimeIntegration_Name(solid.time_integration());
+  if (bricks && implicit) {
+    throw CaseError(fmt::format("{}: field 'solid.time_integration' = {} with solid.element_family = "
+                                "HEXAHEDRON: allowed only for SHELL (no brick tangent yet)", source, integration));
   }
   if (solid.leaflet_self_contact() && (bricks || solid.disable_leaflet_contact())) {
     throw CaseError(fmt::format("{}: field 'solid.leaflet_self_contact' = true with {}: allowed only for SHELL "
@@ -173,12 +175,22 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.max_energy_balance_error = solid.max_energy_balance_error();
   solver_options.fixed_time_step = solid.forced_time_step();
   solver_options.time_step_look_ahead = solid.time_step_look_ahead();
-  if (solid.time_integration() == cases::SolidCase::IMPLICIT) {
+  if (implicit) {
     if (setup.dimension == 2) {
-      throw CaseError(fmt::format("{}: field 'solid.time_integration' = IMPLICIT with run.dimension = 2: allowed "
-                                  "only in 3D (2D strip ties are not in the implicit path)", source));
+      throw CaseError(fmt::format("{}: field 'solid.time_integration' = {} with run.dimension = 2: allowed "
+                                  "only in 3D (2D strip ties are not in the implicit path)", source, integration));
     }
-    solver_options.time_integration = TimeIntegration::implicit_generalized_alpha;
+    solver_options.time_integration = solid.time_integration() == cases::SolidCase::AUTOMATIC
+                                          ? TimeIntegration::automatic
+                                          : TimeIntegration::implicit_generalized_alpha;
+    if (solid.moving_kinetic_ratio() < solid.settled_kinetic_ratio()) {
+      throw CaseError(fmt::format("{}: field 'solid.moving_kinetic_ratio' = {}: allowed >= "
+                                  "solid.settled_kinetic_ratio ({})", source, solid.moving_kinetic_ratio(),
+                                  solid.settled_kinetic_ratio()));
+    }
+    solver_options.settled_kinetic_ratio = solid.settled_kinetic_ratio();
+    solver_options.settled_hold = solid.settled_hold_s();
+    solver_options.moving_kinetic_ratio = solid.moving_kinetic_ratio();
     solver_options.spectral_radius_infinity = solid.spectral_radius_infinity();
     solver_options.implicit_initial_step = solid.implicit_initial_step_s();
     solver_options.implicit_min_step = solid.implicit_min_step_s();

@@ -259,6 +259,12 @@ bool ExplicitSolver::finish_implicit_step(const SolverState& start, double h) {
   return true;
 }
 
+void ExplicitSolver::drop_kept_tangent() {
+  if (!implicit_) return;
+  implicit_->factor_valid = false;
+  implicit_->fast_steps = 0;
+}
+
 void ExplicitSolver::advance_window_implicit(double t_end, const Eigen::Matrix3Xd* nodal_forces) {
   if (!implicit_) prepare_implicit();
   const Eigen::Index n = state_.position.cols();
@@ -276,6 +282,11 @@ void ExplicitSolver::advance_window_implicit(double t_end, const Eigen::Matrix3X
   while (h > first * (1.0 + 1e-9)) h *= 0.5;
   while (state_.time < t_end) {
     h = std::min(h, options_.max_time_step);
+    if (automatic() && pressure_) {
+      const double p = pressure_(state_.time);
+      const double allowed = kAutomaticLoadChangePerStep * std::max(std::abs(p), std::abs(state_.implicit_switch_pressure));
+      while (h > options_.implicit_min_step && std::abs(pressure_(state_.time + h) - p) > allowed) h *= 0.5;
+    }
     const double remaining = t_end - state_.time;
     double step = h;
     bool lands = false;
@@ -309,6 +320,10 @@ void ExplicitSolver::advance_window_implicit(double t_end, const Eigen::Matrix3X
       state_.energy.update_largest_energy();
       if (step_observer_) step_observer_(state_);
       if (options_.max_energy_balance_error > 0.0 && state_.step >= kEnergyCheckFirstStep) check_energy_growth();
+      if (automatic() && moving_again()) {
+        switch_to_explicit();
+        return;
+      }
       continue;
     }
     implicit_->fast_steps = 0;

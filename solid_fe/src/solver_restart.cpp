@@ -97,6 +97,16 @@ void write_solver_restart(const ExplicitSolver& solver, coupling::RestartWriter&
   file.put_integer("solid/tie/captures", s.tie.captures);
   file.put_integer("solid/tie/releases", s.tie.releases);
   file.put("solid/tie/peak_force", s.tie.peak_force);
+  // Implicit dynamics and the automatic switch (ninth session): with the acceleration an implicit
+  // continuation is bit for bit (the kept tangent is rebuilt by both runs, drop_kept_tangent).
+  file.put("solid/energy/numerical_dissipation", s.energy.numerical_dissipation);
+  put_matrix(file, "solid/acceleration", s.acceleration);
+  file.put("solid/implicit_step", s.implicit_step);
+  file.put_integer("solid/newton_iterations", s.newton_iterations);
+  file.put_integer("solid/implicit_phase", s.implicit_phase ? 1 : 0);
+  file.put("solid/settled_since", s.settled_since);
+  file.put("solid/implicit_switch_pressure", s.implicit_switch_pressure);
+  file.put_integer("solid/switches", s.switches);
 }
 
 void write_solver_restart(const ExplicitSolver& solver, const std::filesystem::path& file) {
@@ -154,6 +164,18 @@ void read_solver_restart(const coupling::RestartReader& file, ExplicitSolver& so
   s.calibration_iterations = static_cast<int>(file.integer("solid/calibration_iterations"));
   s.power_vector = get_nodes(file, "solid/power_vector", n, true);
   s.contact_omega2 = file.scalar("solid/contact_omega2");
+  // (files before the ninth session: no implicit state; an implicit run recomputes the
+  // acceleration and starts with its first step, an AUTOMATIC one starts explicit)
+  if (file.has("solid/implicit_phase")) {
+    s.energy.numerical_dissipation = file.scalar("solid/energy/numerical_dissipation");
+    s.acceleration = get_nodes(file, "solid/acceleration", n, true);
+    s.implicit_step = file.scalar("solid/implicit_step");
+    s.newton_iterations = static_cast<int>(file.integer("solid/newton_iterations"));
+    s.implicit_phase = file.integer("solid/implicit_phase") != 0;
+    s.settled_since = file.scalar("solid/settled_since");
+    s.implicit_switch_pressure = file.scalar("solid/implicit_switch_pressure");
+    s.switches = file.integer("solid/switches");
+  }
   const auto pairs = file.integers("solid/contact_candidates/pairs");
   s.contact_candidates.pairs.clear();
   for (std::size_t k = 0; k + 1 < pairs.size(); k += 2) {

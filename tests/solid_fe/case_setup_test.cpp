@@ -68,6 +68,26 @@ TEST(CaseSetup, ImplicitTimeIntegrationIsReadAndRefusedForBricks) {
   }
 }
 
+TEST(CaseSetup, AutomaticSwitchIsReadWithItsThresholdsAndRefusedWhenTheyCross) {
+  const CaseFiles f = write_case("automatic", "time_integration: AUTOMATIC settled_hold_s: 0.002");
+  const SolidSetup setup = setup_from_case(load_case(f.case_file), f.case_file);
+  const SolverOptions& o = setup.shell_solver().options();
+  EXPECT_TRUE(setup.shell_solver().automatic());
+  EXPECT_FALSE(setup.shell_solver().implicit()) << "AUTOMATIC starts explicit";
+  EXPECT_EQ(o.settled_hold, 0.002);
+  EXPECT_EQ(o.settled_kinetic_ratio, 0.05);  // the proto's defaults
+  EXPECT_EQ(o.moving_kinetic_ratio, 0.1);
+  const CaseFiles crossed =
+      write_case("automatic_crossed", "time_integration: AUTOMATIC settled_kinetic_ratio: 0.2 moving_kinetic_ratio: 0.1");
+  try {
+    setup_from_case(load_case(crossed.case_file), crossed.case_file);
+    FAIL() << "a moving threshold below the settled one would switch back at once";
+  } catch (const CaseError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("solid.moving_kinetic_ratio' = 0.1"), std::string::npos) << what;
+  }
+}
+
 TEST(CaseSetup, LeafletSelfContactIsReadAndRefusedForBricks) {
   // The plate has no leaflet_<k> sets: with self-contact the whole mesh is one leaflet.
   const CaseFiles f = write_case("self_contact", "leaflet_self_contact: true");

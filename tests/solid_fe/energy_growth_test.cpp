@@ -23,6 +23,7 @@
 #include "valvefsi/solid/energy_growth_error.hpp"
 #include "valvefsi/solid/mhgo.hpp"
 #include "valvefsi/solid/saint_venant_kirchhoff.hpp"
+#include "valvefsi/solid/material.hpp"
 #include "valvefsi/solid/shell_solver.hpp"
 
 namespace valvefsi::solid::testing {
@@ -92,6 +93,55 @@ TEST(EnergyGrowthStop, UnstableForcedStepIsStoppedBeforeAnythingOverflows) {
     EXPECT_NE(message.find(part), std::string::npos) << part << " missing in: " << message;
   }
   EXPECT_NE(message.find("node " + std::to_string(node)), std::string::npos) << message;
+  // The growth is judged on the plate's own energies: a floor above them would hold the stop back
+  // until the balance passed 0.2 of the floor, past the bound 0.3 of the largest energy above.
+  std::printf("  largest energy %.3g J, the model's floor %.3g J\n", s.energy.largest_energy,
+              solver->energy_check_floor());
+  EXPECT_GT(s.energy.largest_energy, solver->energy_check_floor());
+}
+
+// The floor is the strain energy of the model under a volume-preserving stretch of 1e-3 along x;
+// for the flat SVK plate that is the plane-stress energy of the Green strains it gives
+// (bending zero), times the plate's volume.
+TEST(EnergyGrowthStop, FloorIsTheStrainEnergyOfTheModelAtAStrainOfOneInAThousand) {
+  ShellSolver solver(plate_model(), SaintVenantKirchhoff(kYoungsModulus, kPoisson));
+  const double e = kEnergyFloorStrain;
+  const double exx = 0.5 * ((1.0 + e) * (1.0 + e) - 1.0);
+  const double eyy = 0.5 * (1.0 / (1.0 + e) - 1.0);
+  const double volume = 0.01 * 0.005 * 0.25e-3;
+  const double expected = volume * kYoungsModulus / (2.0 * (1.0 - kPoisson * kPoisson)) *
+                          (exx * exx + eyy * eyy + 2.0 * kPoisson * exx * eyy);
+  std::printf("floor of the SVK plate: %.6g J (plane stress %.6g J)\n", solver.energy_check_floor(), expected);
+  EXPECT_NEAR(solver.energy_check_floor(), expected, 1e-6 * expected);
+}
+
+// Session 8's false stop: a coupled 2D leaflet (MHGO, 0.25 mm thick, 1 mm deep, 2200 kg/m3)
+// stopped at 1.84 ms with a balance error of 0.218 of the largest energy seen, 8.6e-14 J, while it
+// had barely moved. The same ledger on a leaflet of that size (12 mm) is not stopped: the model's
+// floor (its strain energy at a strain of 1e-3) is the scale below which energies are not judged.
+TEST(EnergyGrowthStop, RoundOffSizedLedgerOfABarelyMovedLeafletIsNotStopped) {
+  Mesh mesh = rectangular_plate(0.012, 0.001, 12, 1, 0.25e-3);
+  ShellModelOptions model;
+  model.fixed_nodes = mesh.node_sets.at("left");
+  model.density = 2200.0;
+  SolverOptions options;
+  options.max_energy_balance_error = 0.2;
+  options.fixed_time_step = 1e-7;
+  ShellSolver solver(build_shell_model(mesh, model), Material{Mhgo{}}, options);
+  SolverState ledger = solver.state();
+  ledger.step = 1000;
+  ledger.energy.external_work = 8.6e-14;
+  ledger.energy.internal_work = (1.0 - 0.218) * 8.6e-14;
+  ledger.energy.largest_energy = 8.6e-14;
+  solver.restore(ledger);
+  EXPECT_NO_THROW(solver.advance_window(ledger.time + 1e-6));  // at rest and unloaded: the ledger stays
+  const SolverState& s = solver.state();
+  std::printf("leaflet: floor %.3g J; after %lld steps the balance is %.3g of the largest energy %.3g J\n",
+              solver.energy_check_floor(), static_cast<long long>(s.step - 1000), s.energy.balance_error_of_largest(),
+              s.energy.largest_energy);
+  EXPECT_GE(s.step, 1010);  // (ten steps of 0.1 us, the last split in two)
+  EXPECT_GT(s.energy.balance_error_of_largest(), 0.2) << "without the floor this ledger would be stopped";
+  EXPECT_GT(solver.energy_check_floor(), 1e3 * 8.6e-14);
 }
 
 TEST(EnergyGrowthStop, StableForcedStepClosesItsBalanceAndRuns) {

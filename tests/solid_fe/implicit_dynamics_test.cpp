@@ -192,11 +192,7 @@ TEST(ImplicitDynamics, PressedFlapSettlesWhereTheExplicitSolverDoes) {
     Mesh mesh = rectangular_plate(0.01, 0.005, 10, 5, 0.25e-3);
     ShellModelOptions options;
     options.fixed_nodes = mesh.node_sets.at("left");
-    SolverOptions o;
-    o.time_step_calibration_interval = 2000;
-    o.max_time_step_growth = 0.002;
-    o.time_step_look_ahead = 2.0;
-    o.mass_damping_per_s = 300.0;
+    SolverOptions o = testing::pressed_flap_options();
     if (implicit_integration) {
       o.time_integration = TimeIntegration::implicit_generalized_alpha;
       o.implicit_initial_step = 1e-6;

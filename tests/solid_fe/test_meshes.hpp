@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "valvefsi/solid/explicit_solver.hpp"
 #include "valvefsi/solid/mesh.hpp"
 
 namespace valvefsi::solid::testing {
@@ -56,6 +57,17 @@ inline Mesh rectangular_plate(double lx, double ly, int nx, int ny, double thick
     m.node_sets["top"].push_back(grid_node(i, ny, nx));
   }
   return m;
+}
+
+// The pressed flap's step control (docs/solid_fe.md, "The pressed flap"): calibration every 2000
+// steps, growth 0.2 % per step, look-ahead 2 steps, mass damping 300/s (it settles in ~25 ms).
+inline SolverOptions pressed_flap_options() {
+  SolverOptions o;
+  o.time_step_calibration_interval = 2000;
+  o.max_time_step_growth = 0.002;
+  o.time_step_look_ahead = 2.0;
+  o.mass_damping_per_s = 300.0;
+  return o;
 }
 
 // 2D strip leaflets (docs/mesh-format.md, "2D strips"): each polyline (x-y, attached end first)

@@ -97,6 +97,12 @@ struct SolverState {
   Eigen::Matrix3Xd acceleration;
   double implicit_step = 0;
   int newton_iterations = 0;
+  // Automatic switch: the implicit integrator is stepping; since when the model has been settled
+  // (s; < 0: it is not); the pressure when implicit began (Pa); switches so far.
+  bool implicit_phase = false;
+  double settled_since = -1;
+  double implicit_switch_pressure = 0;
+  std::int64_t switches = 0;
 };
 
 struct SymmetryConstraint {
@@ -120,6 +126,10 @@ struct StripTie {
 enum class TimeIntegration {
   explicit_central_difference,  // the default: lumped-mass central difference, stable-step bound
   implicit_generalized_alpha,   // Newton on each step, adaptive step (implicit_dynamics.cpp)
+  // Explicit while the leaflets move, implicit once they have settled (kinetic energy a small
+  // fraction of the strain energy for a while), explicit again when the load reverses or the
+  // motion returns (docs/solid_fe.md, "Automatic switch").
+  automatic,
 };
 
 struct SolverOptions {
@@ -154,11 +164,25 @@ struct SolverOptions {
   double newton_tolerance = 1e-6;
   int newton_max_iterations = 10;
   int newton_fast_iterations = 4;       // converged within this many twice in a row: the step doubles
+  // Automatic switch: implicit once kinetic <= settled_kinetic_ratio x strain energy has held for
+  // settled_hold (s); explicit again when the pressure changes sign or kinetic > moving_kinetic_ratio
+  // x strain energy.
+  double settled_kinetic_ratio = 0.05;
+  double settled_hold = 5e-3;
+  double moving_kinetic_ratio = 0.1;
 };
 
 // The energy-growth check starts here: the first steps' balance is a ratio of round-off-sized
 // energies.
 inline constexpr std::int64_t kEnergyCheckFirstStep = 100;
+// The energy-growth check's scale is at least the model's strain energy at this strain (a
+// volume-preserving stretch): ledgers of a model that has barely moved hold round-off-sized
+// energies (docs/solid_fe.md, "Energy-growth stop").
+inline constexpr double kEnergyFloorStrain = 1e-3;
+// AUTOMATIC's implicit steps change the pressure by at most this fraction of the larger of the
+// pressure now and at the switch: a release is followed in steps, not jumped over (a 1 ms step
+// across the pressed flap's 1 ms release damped its spring-back: 0.1 mm off at 75 ms).
+inline constexpr double kAutomaticLoadChangePerStep = 0.01;
 
 class ExplicitSolver {
  public:
@@ -193,9 +217,19 @@ class ExplicitSolver {
   // Advances to exactly t_end under `nodal_forces` (3 x nodes, N; constant over the window)
   // added to the pressure load. Throws MaterialStateError naming the element, time and step.
   void advance_window(double t_end, const Eigen::Matrix3Xd* nodal_forces = nullptr);
-  bool implicit() const { return options_.time_integration == TimeIntegration::implicit_generalized_alpha; }
+  // The step now is implicit (IMPLICIT, or AUTOMATIC in its implicit phase).
+  bool implicit() const {
+    return options_.time_integration == TimeIntegration::implicit_generalized_alpha ||
+           (automatic() && state_.implicit_phase);
+  }
+  bool automatic() const { return options_.time_integration == TimeIntegration::automatic; }
+  // Restart points: the next implicit step builds its tangent afresh, as a run continued from the
+  // restart file does (the kept factorisation is not in the file), so both continue bit for bit.
+  void drop_kept_tangent();
 
   const SolverState& state() const { return state_; }
+  // The energy-growth check's smallest scale (J): the strain energy at kEnergyFloorStrain.
+  double energy_check_floor() const { return energy_check_floor_; }
   void restore(const SolverState& saved) {
     state_ = saved;
     internal_force_current_ = true;
@@ -236,6 +270,7 @@ class ExplicitSolver {
   void update_kinetic_energy();
   // Throws EnergyGrowthError when the balance error passes options_.max_energy_balance_error.
   void check_energy_growth() const;
+  double model_energy_floor();
   void add_work(const Eigen::Matrix3Xd& dx);
   // Implicit dynamics (implicit_dynamics.cpp): the window loop, one step of size h from the
   // present state (false when Newton did not converge; the state is then unchanged), and the
@@ -247,6 +282,11 @@ class ExplicitSolver {
   bool factorise_tangent(double h, double t_new, double mass_coefficient, double stiffness_coefficient);
   // Books a converged step from `start` (velocity, acceleration, energies).
   bool finish_implicit_step(const SolverState& start, double h);
+  // Automatic switch: the tests after an explicit step (to implicit) and an implicit one (back).
+  bool settled_for_implicit();
+  bool moving_again() const;
+  void switch_to_explicit();
+  int pressure_sign(double t) const;
   bool has_contact() const { return !contact_planes_.empty() || !contact_cylinders_.empty() || leaflet_contact_; }
 
   std::unique_ptr<ElementModel> elements_;
@@ -272,6 +312,7 @@ class ExplicitSolver {
   struct ImplicitWork;  // sparse matrices, factorisation and work arrays of implicit dynamics
   std::shared_ptr<ImplicitWork> implicit_;
   bool internal_force_current_ = false;
+  double energy_check_floor_ = 0;  // J (model_energy_floor)
   SolverState state_;
 };
 

@@ -14,7 +14,7 @@ import argparse
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import waveform
+from . import closed_load, waveform
 from .mesh_io import write_mesh
 from .tube_case import fluid_block
 from .valve_geometry import ValveParameters
@@ -206,6 +206,11 @@ def write_cases(cases_dir: Path) -> list[Path]:
     for spec in all_specs():
         path = cases_dir / f"{spec.name}.textproto"
         path.write_text(case_text(spec))
+        written.append(path)
+    # the closed valve under peak diastolic load, FE-only and FSI (closed_load.py)
+    for kind in ("FE", "FSI"):
+        path = cases_dir / f"{closed_load.case_name(kind)}.textproto"
+        path.write_text(closed_load.case_text(kind, case_text(CaseSpec(kind, "MHGO", "sector", "coarse"))))
         written.append(path)
     return written
 

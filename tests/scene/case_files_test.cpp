@@ -32,6 +32,25 @@ TEST(SceneCaseFiles, AllTwentyFourArePresent) {
   EXPECT_EQ(scene_cases().size(), 24U);
 }
 
+TEST(SceneCaseFiles, ClosedLoadCasesLoadAndHoldTheLargestReverseDifference) {
+  // the closed valve under peak diastolic load (scripts/valve_scene/closed_load.py): from a blood
+  // at rest (dp = 0) to the Wiggers cycle's largest reverse difference, 97.2 mmHg at 0.361 s
+  const valvefsi::cases::Case cycle = valvefsi::load_case(fs::path(VALVEFSI_CASES_DIR) / "fe-mhgo-sector-coarse.textproto");
+  const valvefsi::PressureWaveform cycle_wf(cycle.waveform(), "cycle");
+  for (const std::string kind : {"fe", "fsi"}) {
+    const fs::path file = fs::path(VALVEFSI_CASES_DIR) / (kind + "-mhgo-sector-coarse-closed-load.textproto");
+    SCOPED_TRACE(file.string());
+    valvefsi::cases::Case c;
+    ASSERT_NO_THROW(c = valvefsi::load_case(file));
+    EXPECT_EQ(c.run().fe_only(), kind == "fe");
+    EXPECT_DOUBLE_EQ(c.run().end_time(), 0.06);
+    const valvefsi::PressureWaveform wf(c.waveform(), file.string());
+    EXPECT_NEAR(mmHg(wf.transvalvular_pressure(0.0)), 0.0, 0.01);
+    EXPECT_NEAR(mmHg(wf.transvalvular_pressure(0.045)), mmHg(cycle_wf.transvalvular_pressure(0.361)), 0.01);
+    EXPECT_LT(mmHg(wf.transvalvular_pressure(0.045)), -90.0);  // reverse: closes the valve
+  }
+}
+
 TEST(SceneCaseFiles, LoadAndMatchTheirNames) {
   const std::regex parts(R"((fe|fsi)-(ogden|mhgo)-(full|sector)-(coarse|medium|fine)\.textproto)");
   for (const auto& file : scene_cases()) {

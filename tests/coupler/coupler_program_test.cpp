@@ -38,6 +38,9 @@ TEST(CouplerSettings, DefaultsFromAnEmptyCouplingSection) {
   EXPECT_DOUBLE_EQ(settings.end_time, 0.5);
   EXPECT_EQ(settings.endpoint, "ipc:///tmp/vfsi-settings/coupler.ipc");
   EXPECT_EQ(settings.series_file, std::filesystem::path("/tmp/vfsi-settings/coupling_series.h5"));
+  EXPECT_DOUBLE_EQ(settings.max_interface_speed, 20.0);
+  EXPECT_DOUBLE_EQ(settings.runaway_oscillation_speed, 0.5);
+  EXPECT_EQ(settings.runaway_growing_blocks, 12);
   EXPECT_EQ(settings.mapping.method, coupling::MappingMethod::nearest_projection);
 }
 

@@ -129,6 +129,37 @@ TEST(ModelProblemsThroughCoupler, AcousticPistonSerialExplicitStableBelowMuTwoDi
   EXPECT_TRUE(stopped_as_runaway(unstable)) << unstable.coupler_log;
 }
 
+// Just beyond the limit the mode grows slowly, |z|^2 = mu / 2 per window: at mu = 2.02 the
+// piston does not reach the 20 m/s speed bound in 1,200 windows (60 ms). The slow-runaway watch
+// (coupling.runaway_oscillation_speed, 0.5 m/s) stops it; switched off, the run ends "fine".
+TEST(ModelProblemsThroughCoupler, AcousticPistonSlowRunawayIsStoppedBelowTheSpeedBound) {
+  const double mu = 1.01 * kSerialLimit;
+  const auto watched = acoustic("mp-serial-slow", "scheme: SERIAL_EXPLICIT", mu, 1200);
+  EXPECT_EQ(watched.codes.at("coupler"), 6) << watched.coupler_log;
+  EXPECT_NE(watched.codes.at("solid"), 0);
+  EXPECT_TRUE(stopped_as_runaway(watched)) << watched.coupler_log;
+  EXPECT_NE(watched.coupler_log.find("jumps in velocity from window to window"), std::string::npos) << watched.coupler_log;
+  std::smatch speed;
+  ASSERT_TRUE(std::regex_search(watched.coupler_log, speed, std::regex(R"(now at ([-+0-9.eE]+) m/s)")));
+  EXPECT_LT(std::stod(speed[1].str()), 1.0) << watched.coupler_log;  // far below the 20 m/s speed bound
+  // The blocks grew as the analysis says: (mu / 2)^(16 / 2) per block of 16 windows.
+  const auto oscillation = read_series(watched.dir / "coupling_series.h5", "interface_oscillation");
+  std::vector<double> blocks;
+  for (std::size_t k = 1; k < oscillation.size(); ++k) {
+    if (oscillation[k] != oscillation[k - 1]) blocks.push_back(oscillation[k]);
+  }
+  ASSERT_GE(blocks.size(), 10u);
+  const double growth = std::pow(blocks.back() / blocks[blocks.size() - 9], 1.0 / 8.0);
+  EXPECT_NEAR(growth, std::pow(mu / 2.0, 8.0), 0.002) << "last block " << blocks.back();
+  EXPECT_GE(blocks.back(), 0.5);
+  EXPECT_LT(blocks[blocks.size() - 2], 0.5);
+
+  // Unwatched, the same run ends with exit code 0 while the mode has grown on tenfold: the gap.
+  const auto unwatched = acoustic("mp-serial-slow-off", "scheme: SERIAL_EXPLICIT runaway_oscillation_speed: 0", mu, 1200);
+  EXPECT_TRUE(all_ok(unwatched)) << unwatched.coupler_log;
+  EXPECT_GT(read_series(unwatched.dir / "coupling_series.h5", "interface_oscillation").back(), 10.0 * blocks.back());
+}
+
 TEST(ModelProblemsThroughCoupler, AcousticPistonParallelExplicitFailsEarlier) {
   const auto stable = acoustic("mp-parallel-stable", "scheme: PARALLEL_EXPLICIT", 0.97 * kParallelLimit, 4000);
   ASSERT_TRUE(all_ok(stable)) << stable.coupler_log;

@@ -60,6 +60,8 @@ CouplerSettings settings_from_case(const cases::Case& run_case, const std::files
   settings.restart_keep = coupling.restart_keep();
   settings.divergence_residual = coupling.divergence_residual();
   settings.max_interface_speed = coupling.max_interface_speed();
+  settings.runaway_oscillation_speed = coupling.runaway_oscillation_speed();
+  settings.runaway_growing_blocks = coupling.runaway_growing_blocks();
   return settings;
 }
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "valvefsi/coupler/oscillation_watch.hpp"
 #include "valvefsi/coupler/restart_points.hpp"
 #include "valvefsi/coupling/acceleration.hpp"
 #include "valvefsi/coupling/restart_points.hpp"
@@ -122,9 +123,18 @@ WindowRecord serial_implicit_window(WindowExchange& exchange, const CouplerSetti
   }
 }
 
+// What to change when the interface runs away, by scheme.
+const char* runaway_remedy(const CouplerSettings& settings) {
+  return settings.scheme == SchemeKind::serial_implicit
+             ? "The implicit iterations did not hold it: try a smaller coupling.window_size or relative_tolerance"
+             : "Under explicit coupling this is the added-mass instability (the leaflet is too light for the window, "
+               "docs/coupling-numerics.md): use a smaller coupling.window_size, scheme SERIAL_IMPLICIT, or a heavier or "
+               "thicker leaflet";
+}
+
 // The failure checks of a completed window (docs/coupling.md, "When the coupling fails").
 void check_window(const WindowRecord& record, const WindowSpan& window, const SolidState& solid,
-                  const CouplerSettings& settings) {
+                  const CouplerSettings& settings, const OscillationWatch& watch) {
   if (!record.converged && settings.divergence_residual > 0.0 && record.relative_residual >= settings.divergence_residual) {
     throw coupling::CouplingFailed(fmt::format(
         "implicit window {} (t = {} s, size {:.3g} s) diverged: relative residual {:.3e} after {} iterations (first "
@@ -144,13 +154,21 @@ void check_window(const WindowRecord& record, const WindowSpan& window, const So
           "coupling.max_interface_speed = {} m/s: the interface is running away. {}; raise max_interface_speed only "
           "if such speeds are physical",
           window.index, window.time, window.time + window.size, node, where.x(), where.y(), where.z(), speed,
-          settings.max_interface_speed,
-          settings.scheme == SchemeKind::serial_implicit
-              ? "The implicit iterations did not hold it: try a smaller coupling.window_size or relative_tolerance"
-              : "Under explicit coupling this is the added-mass instability (the leaflet is too light for the window, "
-                "docs/coupling-numerics.md): use a smaller coupling.window_size, scheme SERIAL_IMPLICIT, or a heavier or "
-                "thicker leaflet"));
+          settings.max_interface_speed, runaway_remedy(settings)));
     }
+  }
+  if (const auto& alarm = watch.alarm()) {
+    const Eigen::Vector3d where = 1e3 * solid.positions.col(alarm->node);
+    const double speed = solid.velocities.col(alarm->node).norm();
+    throw coupling::CouplingFailed(fmt::format(
+        "window {} (t = {} s to {} s): solid interface node {} at ({:.3f}, {:.3f}, {:.3f}) mm (now at {:.3g} m/s) jumps "
+        "in velocity from window to window by {:.3g} m/s RMS over the last {} windows, grown in each of the last {} "
+        "blocks of {} windows from {:.3g} m/s, >= coupling.runaway_oscillation_speed = {} m/s: the interface is running "
+        "away (slowly; a physical motion is smooth over a window). {}; raise runaway_oscillation_speed or "
+        "runaway_growing_blocks only if the leaflet really moves on the window's time scale",
+        window.index, window.time, window.time + window.size, alarm->node, where.x(), where.y(), where.z(), speed,
+        alarm->oscillation, alarm->block_windows, alarm->blocks, alarm->block_windows, alarm->oscillation_before,
+        settings.runaway_oscillation_speed, runaway_remedy(settings)));
   }
 }
 
@@ -174,6 +192,8 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
   std::unique_ptr<coupling::Acceleration> acceleration;
   if (settings.scheme == SchemeKind::serial_implicit) acceleration = coupling::make_acceleration(settings.acceleration);
 
+  // A restart starts it afresh: it needs two windows of velocities and then whole blocks.
+  OscillationWatch watch(settings.runaway_oscillation_speed, settings.runaway_growing_blocks);
   SchemeSummary summary;
   Proposals proposals;
   double time = 0.0;
@@ -225,8 +245,9 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
       coupling::mark_restart_complete(restart, settings.restart_keep);
       spdlog::info("coupler: restart data at t = {} s in {}", window.time, restart.string());
     }
+    record.interface_oscillation = watch.update(solid.velocities);
     observe(record);
-    check_window(record, window, solid, settings);
+    check_window(record, window, solid, settings, watch);
     ++summary.windows;
     summary.total_iterations += record.iterations;
     if (!record.converged) ++summary.unconverged_windows;

@@ -34,9 +34,12 @@ struct CouplerSettings {
   int restart_keep = 2;
   std::filesystem::path restart_from;   // a complete restart folder (resolve_restart_folder)
   double restart_time = 0.0;            // its time, read from the coupler's restart file
-  // Failure checks (coupling.divergence_residual, coupling.max_interface_speed); 0 = off.
+  // Failure checks (coupling.divergence_residual, max_interface_speed, runaway_oscillation_speed
+  // with runaway_growing_blocks); 0 = off.
   double divergence_residual = 1.0;
   double max_interface_speed = 20.0;  // m/s
+  double runaway_oscillation_speed = 0.5;  // m/s
+  int runaway_growing_blocks = 12;
 };
 
 // "serial-explicit", "parallel-explicit", "serial-implicit/iqn-ils" (the acceleration is part

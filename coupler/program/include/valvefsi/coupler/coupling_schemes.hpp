@@ -30,6 +30,7 @@ struct WindowRecord {
   Eigen::Vector3d force_solid = Eigen::Vector3d::Zero();  // sum over the solid's nodes (N)
   double power_fluid = 0.0;   // sum f . v at the fluid's points (W)
   double power_solid = 0.0;   // sum f . v at the solid's nodes (W)
+  double interface_oscillation = 0.0;  // m/s, the last block's (OscillationWatch)
 };
 
 struct SchemeSummary {
@@ -49,7 +50,7 @@ double next_window_size(double time, double end_time, double case_window, double
 // Runs windows from t = 0 to settings.end_time. Throws the transport's errors, and
 // coupling::CouplingFailed (after `observe` has seen the window) when an implicit window
 // diverged or the solid's interface ran away (settings.divergence_residual,
-// settings.max_interface_speed).
+// settings.max_interface_speed, settings.runaway_oscillation_speed).
 SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSettings& settings,
                                   const WindowObserver& observe);
 

@@ -1,0 +1,56 @@
+#pragma once
+// The coupler's watch for a slow interface runaway (docs/coupling.md, "When the coupling fails").
+//
+// The added-mass instability of explicit coupling lives on the scale of the coupling window (the
+// 1D piston's growing mode has a period of 2-4 windows), while a leaflet's physical motion, its
+// closing and its ringing included, is smooth over a window (~100 windows per period or more).
+// So the watch follows each solid interface node's velocity jump between windows,
+// d_n = v_n - 2 v_{n-1} + v_{n-2} (the velocity's departure from the line through the two
+// windows before), as its root mean square over blocks of `kBlockWindows` windows, and takes the
+// largest node: the block's "window-scale oscillation" (m/s). An event (the start, the tips'
+// impact and chatter at closure) raises it for a few blocks and it falls again; a runaway raises
+// it block after block. The watch fires when it has grown in each of the last `growing_blocks`
+// blocks, by at least kGrowthFactor over them, and stands at or above `floor_speed`.
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+
+namespace valvefsi::coupler {
+
+class OscillationWatch {
+ public:
+  static constexpr int kBlockWindows = 16;
+  static constexpr double kGrowthFactor = 1.25;
+
+  // floor_speed <= 0 only measures (never fires).
+  OscillationWatch(double floor_speed, int growing_blocks);
+
+  // After each completed window, with the solid interface's end-of-window node velocities.
+  // Returns the last completed block's window-scale oscillation (m/s; 0 before the first).
+  double update(const Eigen::Matrix3Xd& velocities);
+
+  // Set by update() when the watch fires.
+  struct Alarm {
+    Eigen::Index node = 0;             // the largest node of the last block
+    double oscillation = 0.0;          // its window-scale oscillation (m/s)
+    double oscillation_before = 0.0;   // the largest node's, growing_blocks blocks earlier (m/s)
+    int blocks = 0;                    // growing_blocks
+    int block_windows = kBlockWindows;
+  };
+  [[nodiscard]] const std::optional<Alarm>& alarm() const { return alarm_; }
+
+ private:
+  double floor_speed_;
+  int growing_blocks_;
+  Eigen::Matrix3Xd previous_, before_previous_;
+  Eigen::VectorXd sum_of_squares_;  // per node, this block so far
+  std::uint64_t updates_ = 0;
+  int in_block_ = 0;
+  double last_block_ = 0.0;
+  std::deque<double> blocks_;       // the last growing_blocks + 1 blocks' values
+  std::optional<Alarm> alarm_;
+};
+
+}  // namespace valvefsi::coupler

@@ -95,6 +95,14 @@ FluidSetup<D> fluid_setup_from_case(const cases::Case& c, const std::filesystem:
   s.artificial_viscosity = f.artificial_viscosity();
   s.background_pressure = f.background_pressure();
   s.shifting = f.shifting();
+  switch (f.shifting_density_correction()) {
+    case cases::FluidCase::FIELD_AT_NEW_POSITION: s.shifting_density = FluidSettings<D>::ShiftingDensity::field_gradient; break;
+    case cases::FluidCase::SHIFT_CONTINUITY: s.shifting_density = FluidSettings<D>::ShiftingDensity::continuity; break;
+    default: s.shifting_density = FluidSettings<D>::ShiftingDensity::keep; break;
+  }
+  if (s.shifting_density != FluidSettings<D>::ShiftingDensity::keep && s.shifting == 0)
+    in.fail("shifting_density_correction", fmt::format("= {}, but shifting is 0: set shifting > 0 or remove it (no shift, nothing to correct)",
+                                                       cases::FluidCase::ShiftingDensityCorrection_Name(f.shifting_density_correction())));
   s.gravity = in.vec_or<D>(f.gravity(), "gravity", Vec<D>{});
   s.cfl = f.cfl();
   s.max_density_deviation = f.max_density_deviation();

@@ -117,6 +117,10 @@ void FluidSolver<D>::decompose(MPI_Comm comm) {
       throw std::invalid_argument(fmt::format("fluid MPI decomposition: a mirror plane's normal has a component {} along "
                                               "the slab axis {}; allowed 0 (planes containing the axis, like a sector's) "
                                               "or run on one rank", plane.normal[axis], axis));
+  if (settings_.shifting > 0 && settings_.shifting_density == FluidSettings<D>::ShiftingDensity::continuity)
+    throw std::invalid_argument("fluid MPI decomposition: shifting_density_correction SHIFT_CONTINUITY reads the neighbours' "
+                                "shifts, which are not exchanged across slab borders; run on one rank or use "
+                                "FIELD_AT_NEW_POSITION");
   slabs_ = std::make_unique<SlabDecomposition<D>>(comm, grid_, particles_);
   slabs_->keep_own_and_halo(particles_);
   add_mirror_images();
@@ -516,23 +520,37 @@ void FluidSolver<D>::shift_particles(double dt) {
     for (int d = 0; d < D; ++d) shift[d] *= factor;
     return shift;
   };
+  // Every shift is decided before any particle moves: the density correction reads the
+  // neighbours' shifts at the old positions. 0 for particles that do not move.
+  for (int d = 0; d < D; ++d) shift_.at(d).assign(p.size(), 0.0);
+  auto eligible = [&](std::ptrdiff_t i) { return p.kind[i] == Kind::fluid && p.kernel_sum[i] >= s.free_surface_kernel_sum; };
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t i = first; i < n; ++i) {
-    if (p.kind[i] != Kind::fluid || p.kernel_sum[i] < s.free_surface_kernel_sum) continue;
-    if (with_surface && near_surface_[static_cast<std::size_t>(i)]) continue;  // asked below
+    if (!eligible(i) || (with_surface && near_surface_[static_cast<std::size_t>(i)])) continue;  // near: asked below
     const Vec<D> shift = shift_of(i);
-    for (int d = 0; d < D; ++d) p.position[d][i] += shift[d];
+    for (int d = 0; d < D; ++d) shift_[d][i] = shift[d];
   }
-  if (!with_surface) return;
-  // Near the surface the model decides (a shift must not carry a particle across it); the
-  // model keeps counters, so these calls stay on one thread.
+  if (with_surface) {
+    // Near the surface the model decides (a shift must not carry a particle across it); the
+    // model keeps counters, so these calls stay on one thread.
+    for (std::ptrdiff_t i = first; i < n; ++i) {
+      if (!near_surface_[static_cast<std::size_t>(i)] || !eligible(i)) continue;
+      const Vec<D> shift = shift_of(i);
+      if (!surface_->accept_shift(p, static_cast<std::size_t>(i), shift)) continue;
+      for (int d = 0; d < D; ++d) shift_[d][i] = shift[d];
+    }
+  }
+  const bool correct = s.shifting_density != FluidSettings<D>::ShiftingDensity::keep;
+  if (correct) {
+    const PairFilter<D> filter = pair_filter();
+    shifting_density_change<D>(p, grid_, s, filter, shift_, shift_density_change_, owned_begin_, owned_end_);
+    if (s.shifting_density == FluidSettings<D>::ShiftingDensity::continuity)
+      smooth_shifting_density_change<D>(p, grid_, s, filter, shift_density_change_, shift_density_scratch_, owned_begin_, owned_end_);
+  }
+#pragma omp parallel for schedule(static)
   for (std::ptrdiff_t i = first; i < n; ++i) {
-    if (!near_surface_[static_cast<std::size_t>(i)] || p.kind[i] != Kind::fluid ||
-        p.kernel_sum[i] < s.free_surface_kernel_sum)
-      continue;
-    const Vec<D> shift = shift_of(i);
-    if (!surface_->accept_shift(p, static_cast<std::size_t>(i), shift)) continue;
-    for (int d = 0; d < D; ++d) p.position[d][i] += shift[d];
+    for (int d = 0; d < D; ++d) p.position[d][i] += shift_[d][i];
+    if (correct) p.density_excess[i] += shift_density_change_[i];
   }
 }
 

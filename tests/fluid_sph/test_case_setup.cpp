@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 
 #include "valvefsi/case/case_loader.hpp"
 #include "valvefsi/fluid/case_setup.hpp"
@@ -32,6 +33,19 @@ fluid {
   }
 }
 )";
+
+// The message of the CaseError that reading `text` as the fluid of `file` throws ("no error" if
+// it throws none: the caller's EXPECT then fails with it).
+template <int D>
+std::string setup_error(const std::string& text, const std::string& file) {
+  try {
+    fluid_setup_from_case<D>(parse_case_text(text, file), file);
+  } catch (const CaseError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+std::string case_error(const std::string& text) { return setup_error<2>(text, "channel.textproto"); }
 
 TEST(CaseSetup, ReadsFluidSectionWithDefaults) {
   const cases::Case c = parse_case_text(kChannel, "channel.textproto");
@@ -116,14 +130,7 @@ fluid {
 }
 )";
 
-std::string setup_error_3d(const std::string& text) {
-  try {
-    fluid_setup_from_case<3>(parse_case_text(text, "wedge.textproto"), "wedge.textproto");
-  } catch (const CaseError& e) {
-    return e.what();
-  }
-  return "no error";
-}
+std::string setup_error_3d(const std::string& text) { return setup_error<3>(text, "wedge.textproto"); }
 
 TEST(CaseSetup, HexPrismFillIsReadAndChecked) {
   const FluidSetup<3> setup = fluid_setup_from_case<3>(parse_case_text(kWedge, "wedge.textproto"), "wedge.textproto");
@@ -173,25 +180,31 @@ TEST(CaseSetup, PlatesNeverPullIsReadAndChecked) {
   EXPECT_TRUE(fluid_setup_from_case<2>(parse_case_text(once, "channel.textproto"), "channel.textproto").settings.plate_floor_once_reached);
   std::string once_alone = kChannel;
   once_alone.replace(once_alone.find("  probes {"), 0, "  plate_pressure_floor_once_reached: true\n");
-  try {
-    fluid_setup_from_case<2>(parse_case_text(once_alone, "channel.textproto"), "channel.textproto");
-    FAIL() << "expected a CaseError";
-  } catch (const CaseError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("channel.textproto: field 'fluid.plate_pressure_floor_once_reached' = true, but plates_never_pull is false"),
-              std::string::npos) << what;
-  }
+  std::string what = case_error(once_alone);
+  EXPECT_NE(what.find("channel.textproto: field 'fluid.plate_pressure_floor_once_reached' = true, but plates_never_pull is false"),
+            std::string::npos) << what;
 
   std::string floor_only = kChannel;
   floor_only.replace(floor_only.find("  probes {"), 0, "  plate_pressure_floor_mmHg: 2\n");
-  try {
-    fluid_setup_from_case<2>(parse_case_text(floor_only, "channel.textproto"), "channel.textproto");
-    FAIL() << "expected a CaseError";
-  } catch (const CaseError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("channel.textproto: field 'fluid.plate_pressure_floor_mmHg' = 2, but plates_never_pull is false"),
-              std::string::npos) << what;
+  what = case_error(floor_only);
+  EXPECT_NE(what.find("channel.textproto: field 'fluid.plate_pressure_floor_mmHg' = 2, but plates_never_pull is false"),
+            std::string::npos) << what;
+}
+
+TEST(CaseSetup, ShiftingDensityCorrectionIsReadAndChecked) {
+  using Mode = FluidSettings<2>::ShiftingDensity;
+  EXPECT_EQ(fluid_setup_from_case<2>(parse_case_text(kChannel, "channel.textproto"), "channel.textproto").settings.shifting_density,
+            Mode::keep);  // the default
+  for (const auto& [name, mode] : {std::pair{"FIELD_AT_NEW_POSITION", Mode::field_gradient}, std::pair{"SHIFT_CONTINUITY", Mode::continuity}}) {
+    std::string text = kChannel;
+    text.replace(text.find("  probes {"), 0, std::string("  shifting: 1\n  shifting_density_correction: ") + name + "\n");
+    EXPECT_EQ(fluid_setup_from_case<2>(parse_case_text(text, "channel.textproto"), "channel.textproto").settings.shifting_density, mode);
   }
+  std::string without_shifting = kChannel;
+  without_shifting.replace(without_shifting.find("  probes {"), 0, "  shifting_density_correction: SHIFT_CONTINUITY\n");
+  const std::string what = case_error(without_shifting);
+  EXPECT_NE(what.find("channel.textproto: field 'fluid.shifting_density_correction' = SHIFT_CONTINUITY, but shifting is 0"),
+            std::string::npos) << what;
 }
 
 }  // namespace

@@ -53,6 +53,17 @@ struct FluidSettings {
   // Skipped near a free surface (C below free_surface_kernel_sum).
   double shifting = 0.0;
   double max_shift_fraction = 0.05;
+  // What a shift does to the shifted particle's density (docs/fluid_sph.md, "Shifting and
+  // density"). keep: nothing (the particles move, their density stays: where the shift spreads
+  // particles apart their density ends above their packing). field_gradient: the particle takes
+  // the density field's value at its new position, rho += grad rho . dr with the renormalised
+  // gradient of the fluid's densities (the ALE form of delta+-SPH, Sun et al. 2017).
+  // continuity: the continuity equation applied to the shift's displacement,
+  // m sum_b (dr_a - dr_b) . grad_a W_ab (walls and mirror images do not move; none of its own
+  // within a support of an immersed surface), averaged over the kernel (Shepard), so the
+  // density follows the packing the shift makes. One MPI rank only.
+  enum class ShiftingDensity { keep, field_gradient, continuity };
+  ShiftingDensity shifting_density = ShiftingDensity::keep;
   double free_surface_kernel_sum = 0.9;
   // A fluid particle whose |rho - rho0| exceeds this fraction of rho0 is taken out of the
   // run (counted as lost), as DualSPHysics does with RhopOutMin/Max (700-1300 for water).

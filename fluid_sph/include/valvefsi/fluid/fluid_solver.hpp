@@ -2,6 +2,7 @@
 // The weakly compressible SPH solver: owns the particles, the cell grid and the moving
 // bodies, and advances them with a kick-drift-kick velocity-Verlet step. An optional
 // immersed-surface model (the leaflets) joins the step in the order its header prescribes.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -161,6 +162,9 @@ class FluidSolver {
   float max_acceleration_ = 0.0f;
   std::unique_ptr<ImmersedSurfaceModel<D>> surface_;
   std::vector<std::uint8_t> near_surface_;  // per sorted particle, after classify
+  std::array<std::vector<double>, D> shift_;  // scratch of shift_particles: each particle's shift
+  std::vector<float> shift_density_change_;   // scratch of shift_particles: the shift's density change
+  std::vector<float> shift_density_scratch_;  // scratch of shift_particles
   std::vector<Vec<D>> surface_force_sum_;   // sum of node force x dt since the reset
   double surface_force_time_ = 0.0;
   std::vector<Vec<D>> surface_force_scratch_;

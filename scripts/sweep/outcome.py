@@ -11,7 +11,8 @@ Kinds (docs/stability-map.md), first match wins:
   runaway leaflet (below);
 - `leaks`: particles crossed a leaflet (fluid_probes.h5 interface/leaks > 0); the fluid stops
   above fluid.max_leak_fraction, below it a completed run can end in this class;
-- `energy growth`: the coupler stopped a runaway interface (coupling.max_interface_speed), or
+- `energy growth`: the coupler stopped a runaway interface (coupling.max_interface_speed, or
+  its slow-runaway watch, coupling.runaway_oscillation_speed: both say "running away"), or
   the interface force beyond any physical bound (|F| > `force_bound`; an
   explicit coupling instability and a fluid instability next to the leaflet look alike here:
   the stability map's "window only" group tells them apart), or a leaflet's free edge faster
@@ -42,7 +43,7 @@ PATTERNS = [  # (kind, regex on a log line), checked on error lines first
     # non-positive eigenvalue); not the word 'material', which run folders' names carry
     ("solid failure", re.compile(r"inverted|overflow|eigenvalue", re.IGNORECASE)),
     ("coupling divergence", re.compile(r"diverg|not converged", re.IGNORECASE)),
-    # the coupler's runaway check (coupling.max_interface_speed, docs/coupling.md), and the
+    # the coupler's runaway checks (coupling.max_interface_speed, runaway_oscillation_speed), and the
     # solid's own energy-growth stop (solid.max_energy_balance_error)
     ("energy growth", re.compile(r"interface is running away|energy growth at t =", re.IGNORECASE)),
     # the fluid's leak stop (fluid.max_leak_fraction)

@@ -276,6 +276,16 @@ class Classify(unittest.TestCase):
                                          "20 m/s: the interface is running away\n"})
         o = outcome.classify(self.dir, 6, 0.1, launcher_log=launcher)
         self.assertEqual((o.kind, o.detected_by), ("energy growth", "coupler"))
+        # the slow-runaway watch (session 9): the same class, its message kept
+        watch = ("08:21:39.928 error coupler: window 1441 (t = 0.018733 s to 0.018746 s): solid interface node 12 at "
+                 "(0.1, 6.6, 0.0) mm (now at 2.1 m/s) jumps in velocity from window to window by 0.573 m/s RMS over the "
+                 "last 16 windows, grown in each of the last 12 blocks of 16 windows from 0.0726 m/s, >= "
+                 "coupling.runaway_oscillation_speed = 0.5 m/s: the interface is running away (slowly; a physical "
+                 "motion is smooth over a window). Under explicit coupling this is the added-mass instability\n")
+        write_logs(self.dir, {"coupler": watch})
+        o = outcome.classify(self.dir, 6, 0.1, launcher_log=launcher)
+        self.assertEqual((o.kind, o.detected_by), ("energy growth", "coupler"))
+        self.assertIn("runaway_oscillation_speed = 0.5 m/s", o.detail)
 
     def test_the_programs_own_stops_are_named(self):
         with tempfile.TemporaryDirectory() as tmp:

@@ -115,17 +115,27 @@ def case_text(kind: str, base_text: str) -> str:
 
 # --- analysis ----------------------------------------------------------------------------------
 
+def axial_leaflet_force(run: Path) -> tuple[np.ndarray, np.ndarray] | None:
+    """(window end times, the blood's axial force on the sector's leaflets, N, downstream
+    positive) from the coupler's series; None for an FE-only run."""
+    path = Path(run) / "coupling_series.h5"
+    if not path.exists():
+        return None
+    with h5py.File(path, "r") as f:
+        return f["time"][()].reshape(-1), f["force_fluid"][()][:, 2]
+
+
 def force_at(fsi_run: Path, times: list[float], window_s: float = 0.002) -> list[float | None]:
-    """The blood's axial force on the sector's leaflets (N, downstream positive), averaged over
-    the `window_s` before each time (the closed leaflet rings)."""
-    from .hemodynamics import read_run
-    series = read_run(fsi_run)
-    if series.axial_force is None:
+    """The blood's axial force on the leaflets averaged over the `window_s` before each time
+    (the closed leaflet rings)."""
+    series = axial_leaflet_force(fsi_run)
+    if series is None:
         return [None for _ in times]
+    t_force, force = series
     out = []
     for t in times:
-        pick = (series.force_time > t - window_s) & (series.force_time <= t)
-        out.append(float(np.mean(series.axial_force[pick])) if pick.any() else None)
+        pick = (t_force > t - window_s) & (t_force <= t)
+        out.append(float(np.mean(force[pick])) if pick.any() else None)
     return out
 
 
@@ -151,6 +161,48 @@ def compare(fe_run: Path, fsi_run: Path, times: list[float], mesh_file: Path) ->
     return {"dp_mmHg": ao1 - lv1, "dp_area_sector_N": expected, "rows": rows}
 
 
+def kinetic_energy_series(run: Path) -> tuple[np.ndarray, np.ndarray]:
+    """(time, the leaflet's kinetic energy, J) from the solid's series."""
+    with h5py.File(Path(run) / "solid_series.h5", "r") as f:
+        return f["time"][()], f["energy/kinetic"][()]
+
+
+def growth_rate_per_ms(time: np.ndarray, kinetic: np.ndarray, t0: float, t1: float) -> float:
+    """Exponential growth rate of the kinetic energy over [t0, t1] (least squares on its log)."""
+    pick = (time >= t0) & (time <= t1) & (kinetic > 0)
+    slope = np.polyfit(time[pick] * 1e3, np.log(kinetic[pick]), 1)[0]
+    return float(slope)
+
+
+def plot(runs: dict[str, Path], path: Path) -> None:
+    """The leaflet's kinetic energy (log) and, for coupled runs, the blood's force on it over dp*A."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from .hemodynamics import ANNULUS_RADIUS_M
+    lv1, ao1 = load_end_pressures_mmHg()
+    expected = -(ao1 - lv1) * PASCAL_PER_MMHG * math.pi * ANNULUS_RADIUS_M ** 2 / 6.0
+    fig, (ax_k, ax_f) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True)
+    for index, (label, run) in enumerate(runs.items()):
+        colour = f"C{index}"   # the same run in the same colour in both panels
+        t, k = kinetic_energy_series(run)
+        ax_k.semilogy(t * 1e3, np.maximum(k, 1e-12) * 1e3, color=colour, label=label)
+        force = axial_leaflet_force(run)
+        if force is not None:
+            ax_f.plot(force[0] * 1e3, force[1] / expected, color=colour, lw=0.6, label=label)
+    ax_f.plot(np.linspace(0, END_TIME_S * 1e3, 200), ramp_fraction(np.linspace(0, END_TIME_S, 200)), "k--", lw=1,
+              label="applied load (ramp)")
+    ax_k.set_ylabel("leaflet kinetic energy (mJ, sector)")
+    ax_k.legend(fontsize=8)
+    ax_f.set_ylabel("blood's force on the leaflet / (dp A / 6)")
+    ax_f.set_ylim(-0.5, 2.5)
+    ax_f.set_xlabel("time (ms)")
+    ax_f.legend(fontsize=8)
+    fig.suptitle(f"Closed valve under {ao1 - lv1:.1f} mmHg, coarse MHGO sector")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -159,8 +211,14 @@ def main(argv=None) -> None:
     c.add_argument("fsi_run", type=Path)
     c.add_argument("--times", type=float, nargs="+", default=[0.03, 0.04, 0.05, 0.06])
     c.add_argument("--mesh", type=Path, default=Path(__file__).resolve().parents[2] / "cases/meshes/valve-sector-coarse.mesh.h5")
+    g = sub.add_parser("plot", help="kinetic energy and leaflet force of several runs: LABEL=RUN ...")
+    g.add_argument("runs", nargs="+")
+    g.add_argument("--png", type=Path, required=True)
     args = parser.parse_args(argv)
-    print(json.dumps(compare(args.fe_run, args.fsi_run, args.times, args.mesh), indent=1))
+    if args.command == "compare":
+        print(json.dumps(compare(args.fe_run, args.fsi_run, args.times, args.mesh), indent=1))
+    else:
+        plot({r.split("=", 1)[0]: Path(r.split("=", 1)[1]) for r in args.runs}, args.png)
 
 
 if __name__ == "__main__":

@@ -54,3 +54,24 @@ class ClosedLoad(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class ClosedLoadAnalysis(unittest.TestCase):
+    def test_growth_rate_of_an_exponential(self):
+        t = np.linspace(0.0, 0.05, 501)
+        kinetic = 1e-9 * np.exp(0.23 * t * 1e3)          # e-folding 1/0.23 ms
+        self.assertAlmostEqual(closed_load.growth_rate_per_ms(t, kinetic, 0.02, 0.04), 0.23, places=10)
+
+    def test_force_is_averaged_over_the_window_before_each_time(self):
+        import tempfile
+        import h5py
+        with tempfile.TemporaryDirectory() as run:
+            t = np.arange(1, 1001) * 1e-5                  # window ends, 10 us
+            force = np.zeros((len(t), 3))
+            force[:, 2] = -np.where(t <= 0.005, 1.0, 2.0) + 0.1 * np.sin(2 * np.pi * t / 2e-4)   # a ringing load
+            with h5py.File(Path(run) / "coupling_series.h5", "w") as f:
+                f["time"] = t.reshape(-1, 1)
+                f["force_fluid"] = force
+            got = closed_load.force_at(Path(run), [0.005, 0.01], window_s=0.002)
+            np.testing.assert_allclose(got, [-1.0, -2.0], atol=1e-3)   # the ringing averages out
+            self.assertEqual(closed_load.force_at(Path(run) / "none", [0.01]), [None])

@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 from pathlib import Path
 
 import h5py
@@ -105,10 +106,8 @@ def case_text(kind: str, base_text: str) -> str:
     title_end = body.index("\n") + 1
     run_start, waveform_start, solid_start = body.index("run {"), body.index("waveform {"), body.index("solid {")
     title = body[:title_end].replace('"\n', ', closed-valve load"\n', 1)
-    run = body[run_start:waveform_start]
-    run = run.replace(run[run.index("  end_time:"):run.index("\n", run.index("  end_time:")) + 1], f"  end_time: {END_TIME_S:g}\n")
-    old_dir = run[run.index("  output_dir:"):run.index("\n", run.index("  output_dir:")) + 1]
-    run = run.replace(old_dir, f"  output_dir: \"runs/{name}\"\n")
+    run = re.sub(r"  end_time: [^\n]*\n", f"  end_time: {END_TIME_S:g}\n", body[run_start:waveform_start], count=1)
+    run = re.sub(r"  output_dir: [^\n]*\n", f"  output_dir: \"runs/{name}\"\n", run, count=1)
     return ("\n".join(_wrap_comment(line) for line in header) + "\n" + title + run + waveform_textproto()
             + body[solid_start:])
 

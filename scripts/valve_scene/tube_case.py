@@ -35,6 +35,13 @@ SECTION_PROBE_FRACTIONS = (-0.6, -0.3, 0.3, 0.6)   # extra tap probes across a s
 SECTOR_SECTION_AZIMUTHS_DEG = (10.0, 25.0, 35.0, 50.0)   # the sector's extra tap probes (inside its wedge)
 SKIRT_LAYERS = 3                      # skirt thickness in particle spacings: ceil(2h / dp) at h = 1.3 dp
 SECTOR_SKIRT_MARGIN = math.radians(15.0)  # skirt columns kept beyond the sector's mirror planes
+# Skirt columns reach this far inside the stent radius (in particle spacings), from one spacing
+# below the annulus plane to the attachment line: with them and the tops rounded up to the
+# lattice, the leaflets' attachment line lies inside the wall (its nearest lattice point is a
+# wall point). Without them the line was up to 1.13 dp from the nearest wall particle and, under
+# the closed valve's 97 mmHg, blood squeezed from the sinus under the leaflets' base at ~5 m/s
+# (docs/fsi-3d.md, "The leak under the leaflets' base").
+SKIRT_INNER_OVERLAP = 0.75
 SECTOR_FILL_LATTICE = "HEX_PRISM"     # the sector's fluid lattice (the full valve keeps CUBIC: no mirror planes)
 # The 3D FSI fluid and window (session 6, docs/thin-leaflet.md "coupled sector"): the 2D valve's
 # stable setting. c0 = 20 m/s (10x the waveform's Bernoulli jet speed, Mach <= 0.1), CFL 0.1,
@@ -111,22 +118,34 @@ def lattice_columns(particle_spacing: float, half_extent: float, lattice: str = 
     return [(x, y) for x, y in columns if abs(x) <= half_extent and abs(y) <= half_extent]
 
 
+def lattice_plane_at_or_above(z: float, particle_spacing: float, lattice_z0: float) -> float:
+    """The lowest layer of the fluid lattice at or above z: layers lie at z0 + (k + 1/2) dp."""
+    dp = particle_spacing
+    return lattice_z0 + (math.ceil((z - lattice_z0) / dp - 0.5 - 1e-9) + 0.5) * dp
+
+
 def skirt_columns(particle_spacing: float, valve: ValveParameters | None = None, sector: bool = False,
-                  layers: int = SKIRT_LAYERS, lattice: str = "CUBIC") -> list[tuple[float, float, float]]:
-    """The scalloped skirt above the annulus plane as lattice columns (x, y, top z): every
+                  layers: int = SKIRT_LAYERS, lattice: str = "CUBIC", lattice_z0: float | None = None,
+                  inner_overlap: float = SKIRT_INNER_OVERLAP) -> list[tuple[float, float, float | None, float]]:
+    """The scalloped skirt above the annulus plane as lattice columns (x, y, bottom z, top z): every
     fluid-lattice column (CUBIC or HEX_PRISM, lattice_columns) whose centre lies at
-    R <= r < R + layers * dp, topped at the skirt's top edge (tube.skirt_top_height: the
-    attachment line, the commissure-tab top between tabs) over the column's footprint (its
-    azimuth +- dp / 2r). A sector keeps the columns within its wedge plus a margin."""
+    R - inner_overlap dp <= r < R + layers * dp, topped at the skirt's top edge
+    (tube.skirt_top_height: the attachment line, the commissure-tab top between tabs) over the
+    column's footprint (its azimuth +- dp / 2r), rounded up to the lattice layer at or above it
+    when lattice_z0 (the lattice origin's z) is given. Columns at r >= R start at the ring (bottom
+    None); those inside the stent radius start one spacing below the annulus plane, so they seal
+    under the leaflets' base without narrowing the stent. A sector keeps the columns within its
+    wedge plus a margin."""
     from .tube import skirt_top_height
     valve = valve or ValveParameters()
     dp = particle_spacing
     R = valve.annulus_radius
     outer = R + layers * dp
+    inner = R - inner_overlap * dp
     columns = []
     for x, y in lattice_columns(dp, outer + dp, lattice):
         r = math.hypot(x, y)
-        if not R <= r < outer:
+        if not inner <= r < outer:
             continue
         azimuth = math.atan2(y, x)
         if sector and not -SECTOR_SKIRT_MARGIN <= azimuth <= SECTOR_HALF_ANGLE + SECTOR_SKIRT_MARGIN:
@@ -134,7 +153,10 @@ def skirt_columns(particle_spacing: float, valve: ValveParameters | None = None,
         # the highest top over the column's footprint, so the narrow gap between two
         # commissure tabs (0.5 mm, under a particle) is closed to the tab tops
         footprint = np.linspace(azimuth - 0.5 * dp / r, azimuth + 0.5 * dp / r, 9)
-        columns.append((x, y, float(np.max(skirt_top_height(footprint, valve)))))
+        top = float(np.max(skirt_top_height(footprint, valve)))
+        if lattice_z0 is not None:
+            top = lattice_plane_at_or_above(top, dp, lattice_z0) + 0.01 * dp   # the box holds that layer
+        columns.append((x, y, None if r >= R else -dp, top))
     return columns
 
 
@@ -205,11 +227,12 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
         "  # the annulus plane z = 0 (above it the open leaflets have blood behind them)",
         f"  walls {{ annular_disk {{ origin: {_vec([0, 0, ring_start])} axis: [0, 0, 1] "
         f"thickness: {-ring_start:.6g} inner_radius: {valve.annulus_radius:.6g} outer_radius: {R_tube:.6g} }} }}",
-        f"  # scalloped skirt from the annulus plane to the attachment line, {SKIRT_LAYERS} particles thick:",
-        "  # one solid box per fluid-lattice column (no primitive follows a scallop; tube_case.py)",
-        *[f"  walls {{ solid_box {{ lower: {_vec([x - half_column, y - half_column, ring_start])} "
+        f"  # scalloped skirt from the annulus plane to the attachment line, {SKIRT_LAYERS} particles thick and",
+        f"  # {SKIRT_INNER_OVERLAP:g} dp inside the stent around the attachment (sealing under the leaflets' base):",
+        "  # one solid box per fluid-lattice column, tops at the lattice layer at or above the line (tube_case.py)",
+        *[f"  walls {{ solid_box {{ lower: {_vec([x - half_column, y - half_column, ring_start if bottom is None else bottom])} "
           f"upper: {_vec([x + half_column, y + half_column, top])} }} }}"
-          for x, y, top in skirt_columns(dp, valve, sector, lattice=lattice)],
+          for x, y, bottom, top in skirt_columns(dp, valve, sector, lattice=lattice, lattice_z0=z_inlet)],
         "  # inlet plate: left-ventricular pressure",
         "  plates {",
         f"    shape {{ annular_disk {{ origin: {_vec([0, 0, z_inlet - plate])} axis: [0, 0, 1] thickness: {plate:.6g} outer_radius: {R_tube:.6g} }} }}",

@@ -90,7 +90,7 @@ class StentRing(unittest.TestCase):
     def check(self, sector):
         import numpy as np
         from valve_scene.tube import TubeSetup, skirt_top_height
-        from valve_scene.tube_case import fluid_block
+        from valve_scene.tube_case import SKIRT_INNER_OVERLAP, fluid_block, lattice_plane_at_or_above
         from valve_scene.valve_geometry import SECTOR_HALF_ANGLE, ValveParameters
         dp = 0.9e-3
         valve, setup = ValveParameters(), TubeSetup()
@@ -127,9 +127,16 @@ class StentRing(unittest.TestCase):
             # sealed: every lattice point of the skirt wall (R <= r < R + 3 dp) under the attachment line
             under = wedge & (r >= R) & (r < R + 3 * dp) & (z < top_at)
             self.assertTrue(np.all(solid[under]), f"skirt gap at z = {z}")
+            # sealed under the leaflets' base: the lattice points just inside the stent radius are
+            # solid from one spacing below the annulus plane up to the attachment line, so the line
+            # lies inside the wall (tests/scene/skirt_seal_test.cpp checks it on fluid_sph's fill)
+            seal = wedge & (r >= R - SKIRT_INNER_OVERLAP * dp) & (r < R) & (z > -dp) & (z < top_at)
+            self.assertTrue(np.all(solid[seal]), f"no seal under the leaflets' base at z = {z}")
             # blood behind the leaflets: outside the skirt and above the annulus plane nothing is solid,
-            # and inside the stent never
-            self.assertFalse(np.any(solid[wedge & (r < R)]), f"skirt inside the stent at z = {z}")
+            # and inside the stent nothing but that seal
+            self.assertFalse(np.any(solid[wedge & (r < R - SKIRT_INNER_OVERLAP * dp)]), f"skirt inside the stent at z = {z}")
+            if z < -dp:
+                self.assertFalse(np.any(solid[wedge & (r < R)]), f"seal narrows the stent at z = {z}")
             if z > 0:
                 self.assertFalse(np.any(solid[wedge & (r >= R + 3 * dp) & (r < R_tube)]), f"ring above the annulus at z = {z}")
             if z > valve.commissure_height + dp:
@@ -138,7 +145,11 @@ class StentRing(unittest.TestCase):
         # at the commissures it reaches the tab tops
         centre = boxes[np.argmin(np.abs(np.arctan2(boxes[:, 1] + boxes[:, 4], boxes[:, 0] + boxes[:, 3])))]
         self.assertLess(centre[5], dp)
-        self.assertAlmostEqual(boxes[:, 5].max(), valve.commissure_height, delta=1e-12)
+        # tops at the lattice layer at or above the line (lattice_origin z = the inlet plane)
+        z_lattice = -setup.upstream_length
+        self.assertAlmostEqual(boxes[:, 5].max(), lattice_plane_at_or_above(valve.commissure_height, dp, z_lattice) + 0.01 * dp, delta=1e-12)
+        self.assertAlmostEqual(lattice_plane_at_or_above(0.35e-3, dp, z_lattice), 0.35e-3, delta=1e-12)
+        self.assertAlmostEqual(lattice_plane_at_or_above(0.36e-3, dp, z_lattice), 1.25e-3, delta=1e-12)
 
     def test_full_valve(self):
         self.check(sector=False)

@@ -195,6 +195,15 @@ FluidSetup<D> fluid_setup_from_case(const cases::Case& c, const std::filesystem:
       default:
         plate.pressure = [offset](double) { return offset; };
     }
+    if (pc.travel_range_size() != 0) {
+      if (pc.travel_range_size() != 2 || pc.travel_range(0) > 0 || pc.travel_range(1) < 0) {
+        std::string values;
+        for (double v : pc.travel_range()) values += (values.empty() ? "" : ", ") + fmt::format("{}", v);
+        in.fail(field + ".travel_range", "= [" + values + "]: allowed two values, [least <= 0, most >= 0] (m), or none");
+      }
+      plate.min_displacement = pc.travel_range(0);
+      plate.max_displacement = pc.travel_range(1);
+    }
     setup.plates.push_back(plate);
   }
   s.plates_never_pull = f.plates_never_pull();

@@ -475,6 +475,7 @@ void FluidSolver<D>::step() {
   if (settings_.shifting > 0) shift_particles(dt);
   ++steps_;
   if (surface_) check_leaks();  // the state is complete: it can be written
+  check_plate_travel();
   choose_time_step();
 }
 
@@ -598,6 +599,24 @@ void FluidSolver<D>::choose_time_step() {
         "or set fluid.min_time_step_ratio to go on",
         time_, dt_, s.min_time_step_ratio, dt_at_rest, limit, max_speed_, surface_ ? surface_->max_node_speed() : 0.0,
         max_acceleration_, describe_extremes()));
+  }
+}
+
+template <int D>
+void FluidSolver<D>::check_plate_travel() const {
+  for (std::size_t k = 0; k < plates_.size(); ++k) {
+    const auto& plate = plates_[k];
+    if (plate.displacement >= plate.min_displacement && plate.displacement <= plate.max_displacement) continue;
+    double normal_force = 0.0;
+    for (int d = 0; d < D; ++d) normal_force += plate.fluid_force[d] * plate.normal[d];
+    throw PlateTravelExceeded(fmt::format(
+        "pressure plate {} (fluid.plates[{}]) has moved {:.6g} m along its normal by t = {:.6g} s (step {}), outside its "
+        "travel_range [{:.6g}, {:.6g}] m: beyond it the plate leaves its channel and the fluid escapes round it; plate "
+        "velocity {:.3g} m/s, fluid force along the normal {:.6g} N, prescribed pressure {:.6g} Pa (plus the common level "
+        "{:.6g} Pa); find what moves the fluid's volume (a leak past the valve, a density drift) or lengthen the channel "
+        "and the plate's travel_range",
+        k, k, plate.displacement, time_, steps_, plate.min_displacement, plate.max_displacement, plate.velocity, normal_force,
+        plate.pressure(time_), plate_pressure_level(time_)));
   }
 }
 

@@ -2,6 +2,7 @@
 // reported with the file, the field, the value and what is allowed.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -189,6 +190,26 @@ TEST(CaseSetup, PlatesNeverPullIsReadAndChecked) {
   what = case_error(floor_only);
   EXPECT_NE(what.find("channel.textproto: field 'fluid.plate_pressure_floor_mmHg' = 2, but plates_never_pull is false"),
             std::string::npos) << what;
+}
+
+TEST(CaseSetup, PlateTravelRangeIsReadAndChecked) {
+  std::string text = kChannel;
+  const auto with_range = [&](const std::string& range) {
+    std::string t = text;
+    t.replace(t.find("pressure_mmHg: 10"), 17, "pressure_mmHg: 10 travel_range: " + range);
+    return t;
+  };
+  const FluidSetup<2> bounded = fluid_setup_from_case<2>(parse_case_text(with_range("[-0.02, 0.1]"), "channel.textproto"), "channel.textproto");
+  EXPECT_DOUBLE_EQ(bounded.plates.at(0).min_displacement, -0.02);
+  EXPECT_DOUBLE_EQ(bounded.plates.at(0).max_displacement, 0.1);
+  const FluidSetup<2> open = fluid_setup_from_case<2>(parse_case_text(text, "channel.textproto"), "channel.textproto");
+  EXPECT_TRUE(std::isinf(open.plates.at(0).min_displacement) && open.plates.at(0).min_displacement < 0);
+  EXPECT_TRUE(std::isinf(open.plates.at(0).max_displacement) && open.plates.at(0).max_displacement > 0);
+  for (const std::string range : {"[0.01, 0.1]", "[-0.02]", "[-0.02, -0.01]"}) {
+    const std::string what = case_error(with_range(range));
+    EXPECT_NE(what.find("channel.textproto: field 'fluid.plates[0].travel_range' = ["), std::string::npos) << what;
+    EXPECT_NE(what.find("allowed two values, [least <= 0, most >= 0]"), std::string::npos) << what;
+  }
 }
 
 TEST(CaseSetup, ShiftingDensityCorrectionIsReadAndChecked) {

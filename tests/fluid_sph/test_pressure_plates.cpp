@@ -3,6 +3,8 @@
 //     prescribed pressure and the plate has moved s = p0 L / (rho0 c0^2) (linear EOS, eq. 5).
 //  2. Two plates with different pressures accelerate the column as one rigid body:
 //     a = (p_left - p_right) A / (M_fluid + m_plates).
+//  3. A plate whose displacement leaves its travel range stops the run naming the plate (a plate
+//     that leaves its channel lets the fluid escape round it); inside it the run goes on.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -93,6 +95,36 @@ TEST(PressurePlates, PressureDifferenceAcceleratesColumnAsRigidBody) {
   EXPECT_NEAR(solver.plates()[0].displacement, 0.5 * acceleration * t * t, 0.05 * 0.5 * acceleration * t * t);
   EXPECT_NEAR(-solver.plates()[1].displacement, 0.5 * acceleration * t * t, 0.05 * 0.5 * acceleration * t * t);
   EXPECT_EQ(solver.lost_count(), 0u);
+}
+
+TEST(PressurePlates, PlateLeavingItsTravelRangeStopsTheRunNamingIt) {
+  const double p0 = 2000.0;
+  const double settled = p0 * L / (rho * c0 * c0);  // 5 mm
+  const auto run = [&](double most, double until) {
+    auto c = channel(false, 2.0);
+    Particles<2> particles = fill_particles(c.scene, c.settings);
+    std::vector<PressurePlate<2>> plates = {plate(particles, 1, {1.0, 0.0}, p0, c.settings.particle_mass())};
+    plates[0].min_displacement = -1e-3;
+    plates[0].max_displacement = most;
+    FluidSolver<2> solver(c.settings, std::move(particles), std::move(plates));
+    solver.advance_to(until);
+    return solver.plates()[0].displacement;
+  };
+  // Half-way to where the compressed column holds it, the plate is out of range: stopped there,
+  // within one step's travel (dt < 1 ms, plate speed < 0.1 m/s) of the limit.
+  try {
+    run(0.5 * settled, 4.0);
+    FAIL() << "expected a PlateTravelExceeded";
+  } catch (const PlateTravelExceeded& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("pressure plate 0 (fluid.plates[0]) has moved 0.0025"), std::string::npos) << what;
+    EXPECT_NE(what.find("outside its travel_range [-0.001, 0.0025] m"), std::string::npos) << what;
+  }
+  // The step load overshoots: at 1.3x the settled travel the plate is stopped on its first swing
+  // (6.51 mm at 66 ms); with room for the undamped step response's peak, twice the settled travel
+  // (which test 1 finds up to 6 % above p0 L / (rho0 c0^2)), the run goes on and the plate settles.
+  EXPECT_THROW(run(1.3 * settled, 2.0), PlateTravelExceeded);
+  EXPECT_NEAR(run(2.0 * 1.06 * settled, 2.0), settled, 0.2 * settled);
 }
 
 }  // namespace

@@ -44,6 +44,12 @@ class LeakLimitExceeded : public FluidStop {
   using FluidStop::FluidStop;
 };
 
+// Thrown when a pressure plate's displacement leaves its [min_displacement, max_displacement].
+class PlateTravelExceeded : public FluidStop {
+ public:
+  using FluidStop::FluidStop;
+};
+
 template <int D>
 class FluidSolver {
  public:
@@ -136,6 +142,7 @@ class FluidSolver {
   void update_owned_range();
   std::string describe_extremes() const;
   void check_leaks() const;
+  void check_plate_travel() const;
   double lowest_plate_drive(double t) const;  // min over plates of prescribed + background (Pa)
   void note_plate_floor(double t);
   PairFilter<D> pair_filter() const;

@@ -5,6 +5,7 @@
 // This is how the reference applies its pressure boundary conditions (two rigid plates,
 // section 2.3); the particles next to the plate then carry a flat velocity profile.
 #include <functional>
+#include <limits>
 
 #include "valvefsi/fluid/particles.hpp"
 
@@ -16,6 +17,9 @@ struct PressurePlate {
   double area = 0.0;      // wetted area (m^2; m per unit depth in 2D)
   double mass = 0.0;      // kg (per unit depth in 2D)
   std::function<double(double)> pressure;  // prescribed pressure at time t (Pa)
+  // Displacements the plate may reach (m); beyond them the solver stops (PlateTravelExceeded).
+  double min_displacement = -std::numeric_limits<double>::infinity();
+  double max_displacement = std::numeric_limits<double>::infinity();
 
   // State along the normal.
   double displacement = 0.0;  // m

@@ -68,6 +68,17 @@ bool stopped_as_runaway(const Outcome& o) {
          o.coupler_log.find("the interface is running away") != std::string::npos;
 }
 
+// The stop's diagnosis measured the piston's mode at the window's scale (a period of 2-4
+// windows) and named the added-mass instability and its remedies (runaway_diagnosis.hpp).
+bool named_added_mass(const Outcome& o) {
+  std::smatch period;
+  return o.coupler_log.find("It grows at the window's scale") != std::string::npos &&
+         o.coupler_log.find("added-mass instability") != std::string::npos &&
+         o.coupler_log.find("SERIAL_IMPLICIT") != std::string::npos &&
+         std::regex_search(o.coupler_log, period, std::regex(R"(equivalent period of ([0-9.]+) windows)")) &&
+         std::stod(period[1].str()) >= 2.0 && std::stod(period[1].str()) <= 4.1;
+}
+
 // ---------------------------------------------------------------- incompressible piston
 // m_s = 4 g, m_a = rho L A = 10 g: limit 2 / 3.5. F_ext = 0.1 N, dt = 1 ms.
 constexpr double kStructureMass = 0.004, kAddedMass = 0.01, kExternalForce = 0.1;
@@ -127,6 +138,8 @@ TEST(ModelProblemsThroughCoupler, AcousticPistonSerialExplicitStableBelowMuTwoDi
   const auto unstable = acoustic("mp-serial-unstable", "scheme: SERIAL_EXPLICIT", 1.03 * kSerialLimit, 3000);
   EXPECT_NE(unstable.codes.at("solid"), 0);
   EXPECT_TRUE(stopped_as_runaway(unstable)) << unstable.coupler_log;
+  EXPECT_TRUE(named_added_mass(unstable)) << unstable.coupler_log;
+  std::printf("%s\n", unstable.coupler_log.substr(unstable.coupler_log.find("error coupler:")).c_str());
 }
 
 // Just beyond the limit the mode grows slowly, |z|^2 = mu / 2 per window: at mu = 2.02 the
@@ -142,6 +155,8 @@ TEST(ModelProblemsThroughCoupler, AcousticPistonSlowRunawayIsStoppedBelowTheSpee
   std::smatch speed;
   ASSERT_TRUE(std::regex_search(watched.coupler_log, speed, std::regex(R"(now at ([-+0-9.eE]+) m/s)")));
   EXPECT_LT(std::stod(speed[1].str()), 1.0) << watched.coupler_log;  // far below the 20 m/s speed bound
+  EXPECT_TRUE(named_added_mass(watched)) << watched.coupler_log;
+  std::printf("%s\n", watched.coupler_log.substr(watched.coupler_log.find("error coupler:")).c_str());
   // The blocks grew as the analysis says: (mu / 2)^(16 / 2) per block of 16 windows.
   const auto oscillation = read_series(watched.dir / "coupling_series.h5", "interface_oscillation");
   std::vector<double> blocks;

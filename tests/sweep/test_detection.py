@@ -169,6 +169,18 @@ class SlowRunaway(FailingScene):
         o = outcome.classify(self.run_dir, self.cost.exit_code, self.END_TIME, launcher_log=self.work / "launcher.log")
         self.assertEqual((o.kind, o.detected_by), ("energy growth", "coupler"))
 
+    def test_the_diagnosis_names_the_added_mass_instability(self):
+        # The stop's diagnosis (coupler/program runaway_diagnosis.hpp): the jumps of the node's
+        # velocity swing with a period of ~9 windows (measured 9.12 in session 10), within the
+        # window's scale (up to 12), so the cause named is the coupling's, with its remedies.
+        period = re.search(r"the jumps with an equivalent period of ([0-9.]+) windows", self.coupler_log)
+        self.assertIsNotNone(period, self.coupler_log[-2000:])
+        self.assertGreater(float(period.group(1)), 4.0)
+        self.assertLessEqual(float(period.group(1)), 12.0)
+        for words in ("It grows at the window's scale", "added-mass instability", "SERIAL_IMPLICIT"):
+            self.assertIn(words, self.coupler_log)
+        self.assertNotIn("not the coupling's added-mass instability", self.coupler_log)
+
     def test_the_series_shows_the_growth_up_to_the_stopped_window(self):
         self.assertIsNotNone(self.match, self.coupler_log[-2000:])
         with h5py.File(self.run_dir / "coupling_series.h5", "r") as f:

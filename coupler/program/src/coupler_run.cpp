@@ -38,14 +38,16 @@ std::vector<SeriesColumn> series_columns() {
       {"interface_oscillation", 1, "m/s",
        "largest solid interface node's RMS velocity jump between windows (v_n - 2 v_n-1 + v_n-2) over the last "
        "complete block of 16 windows (coupling.runaway_oscillation_speed)"},
+      {"load_work_solid", 1, "J",
+       "sum of force . (x_end - x_start) at the solid's nodes: the loads' work on the solid over the window"},
   };
 }
 
-std::array<double, 14> series_row(const WindowRecord& r) {
+std::array<double, 15> series_row(const WindowRecord& r) {
   return {r.time_end,        r.size,           static_cast<double>(r.index), static_cast<double>(r.iterations),
           r.relative_residual, r.force_fluid.x(), r.force_fluid.y(),          r.force_fluid.z(),
           r.force_solid.x(), r.force_solid.y(), r.force_solid.z(),          r.power_fluid,
-          r.power_solid,     r.interface_oscillation};
+          r.power_solid,     r.interface_oscillation, r.load_work_solid};
 }
 
 void finish_run(MessageChannel& channel, double end_time) {

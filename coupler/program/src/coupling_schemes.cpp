@@ -8,6 +8,7 @@
 
 #include "valvefsi/coupler/oscillation_watch.hpp"
 #include "valvefsi/coupler/restart_points.hpp"
+#include "valvefsi/coupler/runaway_diagnosis.hpp"
 #include "valvefsi/coupling/acceleration.hpp"
 #include "valvefsi/coupling/restart_points.hpp"
 #include "valvefsi/coupling/transport_errors.hpp"
@@ -21,6 +22,11 @@ constexpr double kSliver = 1e-6;
 
 double power(const Eigen::Matrix3Xd& forces, const Eigen::Matrix3Xd& velocities) {
   return (forces.array() * velocities.array()).sum();
+}
+
+// The loads' work on the solid over a window: they are held over it, so F . (x_end - x_start).
+double load_work(const Eigen::Matrix3Xd& node_forces, const SolidState& start, const SolidState& end) {
+  return (node_forces.array() * (end.positions - start.positions).array()).sum();
 }
 
 void fill_record(WindowRecord& record, const WindowSpan& window, const Eigen::Matrix3Xd& fluid_forces,
@@ -52,6 +58,7 @@ WindowRecord serial_explicit_window(WindowExchange& exchange, const WindowSpan& 
   auto reply = exchange.receive_solid();
   WindowRecord record;
   fill_record(record, window, fluid.forces, fluid_velocities, node_forces, solid.velocities);
+  record.load_work_solid = load_work(node_forces, solid, reply.state);
   solid = std::move(reply.state);
   proposals = {fluid.max_stable_window, reply.max_stable_window};
   return record;
@@ -65,6 +72,7 @@ WindowRecord parallel_explicit_window(WindowExchange& exchange, const WindowSpan
   auto reply = exchange.receive_solid();
   WindowRecord record;
   fill_record(record, window, fluid.forces, fluid_velocities, previous_node_forces, solid.velocities);
+  record.load_work_solid = load_work(previous_node_forces, solid, reply.state);
   previous_node_forces = exchange.loads_to_nodes(fluid.forces);
   solid = std::move(reply.state);
   proposals = {fluid.max_stable_window, reply.max_stable_window};
@@ -116,6 +124,7 @@ WindowRecord serial_implicit_window(WindowExchange& exchange, const CouplerSetti
         spdlog::warn("coupler: window {} (t = {} s) not converged after {} iterations: relative residual {:.3e} >= {:.1e}",
                      window.index, window.time, k + 1, residual, settings.relative_tolerance);
       }
+      record.load_work_solid = load_work(node_forces, solid, reply.state);
       solid = std::move(reply.state);
       return record;
     }
@@ -123,18 +132,11 @@ WindowRecord serial_implicit_window(WindowExchange& exchange, const CouplerSetti
   }
 }
 
-// What to change when the interface runs away, by scheme.
-const char* runaway_remedy(const CouplerSettings& settings) {
-  return settings.scheme == SchemeKind::serial_implicit
-             ? "The implicit iterations did not hold it: try a smaller coupling.window_size or relative_tolerance"
-             : "Under explicit coupling this is the added-mass instability (the leaflet is too light for the window, "
-               "docs/coupling-numerics.md): use a smaller coupling.window_size, scheme SERIAL_IMPLICIT, or a heavier or "
-               "thicker leaflet";
-}
-
 // The failure checks of a completed window (docs/coupling.md, "When the coupling fails").
 void check_window(const WindowRecord& record, const WindowSpan& window, const SolidState& solid,
-                  const CouplerSettings& settings, const OscillationWatch& watch) {
+                  const CouplerSettings& settings, const OscillationWatch& watch, const InterfaceHistory& history) {
+  // What the coupler can tell of the cause: the node's time scale and the loads' work.
+  auto cause = [&](Eigen::Index node) { return explain_runaway(diagnose_runaway(history, node), settings.scheme); };
   if (!record.converged && settings.divergence_residual > 0.0 && record.relative_residual >= settings.divergence_residual) {
     throw coupling::CouplingFailed(fmt::format(
         "implicit window {} (t = {} s, size {:.3g} s) diverged: relative residual {:.3e} after {} iterations (first "
@@ -154,7 +156,7 @@ void check_window(const WindowRecord& record, const WindowSpan& window, const So
           "coupling.max_interface_speed = {} m/s: the interface is running away. {}; raise max_interface_speed only "
           "if such speeds are physical",
           window.index, window.time, window.time + window.size, node, where.x(), where.y(), where.z(), speed,
-          settings.max_interface_speed, runaway_remedy(settings)));
+          settings.max_interface_speed, cause(node)));
     }
   }
   if (const auto& alarm = watch.alarm()) {
@@ -164,11 +166,11 @@ void check_window(const WindowRecord& record, const WindowSpan& window, const So
         "window {} (t = {} s to {} s): solid interface node {} at ({:.3f}, {:.3f}, {:.3f}) mm (now at {:.3g} m/s) jumps "
         "in velocity from window to window by {:.3g} m/s RMS over the last {} windows, grown in each of the last {} "
         "blocks of {} windows from {:.3g} m/s, >= coupling.runaway_oscillation_speed = {} m/s: the interface is running "
-        "away (slowly; a physical motion is smooth over a window). {}; raise runaway_oscillation_speed or "
+        "away (slowly). {}; raise runaway_oscillation_speed or "
         "runaway_growing_blocks only if the leaflet really moves on the window's time scale",
         window.index, window.time, window.time + window.size, alarm->node, where.x(), where.y(), where.z(), speed,
         alarm->oscillation, alarm->block_windows, alarm->blocks, alarm->block_windows, alarm->oscillation_before,
-        settings.runaway_oscillation_speed, runaway_remedy(settings)));
+        settings.runaway_oscillation_speed, cause(alarm->node)));
   }
 }
 
@@ -194,6 +196,7 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
 
   // A restart starts it afresh: it needs two windows of velocities and then whole blocks.
   OscillationWatch watch(settings.runaway_oscillation_speed, settings.runaway_growing_blocks);
+  InterfaceHistory history;
   SchemeSummary summary;
   Proposals proposals;
   double time = 0.0;
@@ -246,8 +249,9 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
       spdlog::info("coupler: restart data at t = {} s in {}", window.time, restart.string());
     }
     record.interface_oscillation = watch.update(solid.velocities);
+    history.update(solid.velocities, record.load_work_solid, record.power_solid * record.size);
     observe(record);
-    check_window(record, window, solid, settings, watch);
+    check_window(record, window, solid, settings, watch, history);
     ++summary.windows;
     summary.total_iterations += record.iterations;
     if (!record.converged) ++summary.unconverged_windows;

@@ -30,6 +30,9 @@ struct WindowRecord {
   Eigen::Vector3d force_solid = Eigen::Vector3d::Zero();  // sum over the solid's nodes (N)
   double power_fluid = 0.0;   // sum f . v at the fluid's points (W)
   double power_solid = 0.0;   // sum f . v at the solid's nodes (W)
+  // sum f . (x_end - x_start) at the solid's nodes (J): the loads' work on the solid over the
+  // window, which power_solid x size (the velocity at the window's start) only approximates
+  double load_work_solid = 0.0;
   double interface_oscillation = 0.0;  // m/s, the last block's (OscillationWatch)
 };
 

@@ -25,6 +25,7 @@ import h5py
 import numpy as np
 
 from . import waveform
+from .tube_case import FSI_3D_PLATE_PRESSURE_RESERVE_MMHG
 
 RAMP_S = 0.030        # cosine ramp of the load: slower than the leaflet's closed period, faster than the cycle's 0.245 -> 0.36 s
 END_TIME_S = 0.060    # the ramp and 30 ms held
@@ -52,9 +53,13 @@ def ramp_fraction(t) -> np.ndarray:
 
 
 def pressures_mmHg(t) -> tuple[np.ndarray, np.ndarray]:
+    """The plates' drives: the ventricle ramps from the start to the start + the cycle's pressure
+    reserve (tube_case.FSI_3D_PLATE_PRESSURE_RESERVE_MMHG), the aorta to that + the largest reverse
+    difference, which is where the cycle's plates stand then (its reserve engaged in ejection)."""
     (lv0, ao0), (lv1, ao1) = load_start_pressures_mmHg(), load_end_pressures_mmHg()
     f = ramp_fraction(t)
-    return lv0 + f * (lv1 - lv0), ao0 + f * (ao1 - ao0)
+    reserve = FSI_3D_PLATE_PRESSURE_RESERVE_MMHG
+    return lv0 + f * reserve, ao0 + f * (reserve + ao1 - lv1)
 
 
 def waveform_textproto() -> str:
@@ -91,7 +96,9 @@ def case_text(kind: str, base_text: str) -> str:
         f"the transvalvular pressure is ramped over {RAMP_S * 1e3:g} ms (cosine) from 0 to the cycle's largest reverse "
         f"difference, {ao1 - lv1:.1f} mmHg (LV {lv1:.2f}, Ao {ao1:.2f} mmHg, at {PEAK_REVERSE_TIME_S:g} s of the Wiggers table), "
         f"then held to {END_TIME_S * 1e3:g} ms" + (" (uniform pressure on the leaflets, no fluid)." if fe else
-                                                   " (the two plates; the blood starts at rest at gauge 0)."),
+                                                   " (the two plates; the blood starts at rest at gauge 0; both plates "
+                                                   f"rise by the cycle's {FSI_3D_PLATE_PRESSURE_RESERVE_MMHG:g} mmHg pressure reserve "
+                                                   "as the cycle's stand then)."),
         "# What it should show: the closed valve's equilibrium under peak diastolic load"
         + (", against which the FSI variant is compared." if fe else
            ": the leaflets' strain and shape as the FE-only variant's, the blood's force on the leaflets "

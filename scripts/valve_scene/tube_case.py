@@ -55,6 +55,13 @@ BLOOD_DENSITY = 1056.0                # kg/m^3, blood
 FSI_3D_SOUND_SPEED = 20.0
 FSI_3D_CFL = 0.1
 FSI_3D_LOAD_SMOOTHING_RADIUS_RATIO = 3.0
+# The plates' pressure reserve once reached (mmHg above gauge 0): from the first instant the lower
+# plate's drive reaches it (0.118 s, in ejection; the largest lower drive of the cycle is 38.6
+# mmHg at 0.158 s) both plates are lifted so that the lower one never falls below it. With the
+# floor at 0 the diastolic ventricle's plate cannot hold the blood column the closing leaflets
+# push: it coasted away at 0.32 m/s and tore the blood under the leaflets into tension
+# (docs/fsi-3d.md, "What drives the closed leaflet").
+FSI_3D_PLATE_PRESSURE_RESERVE_MMHG = 35.0
 FSI_3D_MAX_COUPLING_WINDOW_S = 13.0e-6  # mu = 2: the explicit coupling's limit (docs/stability-map.md)
 FSI_3D_SMOOTHING_LENGTH_RATIO = 1.3     # the fluid's default h / dp
 # The fluid sub-cycles a window and shortens its last step to land on the window's end, so a 13 us
@@ -207,6 +214,9 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
         "  # through the leaflets' incomplete kernels. No plate ever pulls on the blood.",
         "  background_pressure: 0",
         "  plates_never_pull: true",
+        f"  # a pressure reserve for the diastolic blood columns, engaged in ejection (tube_case.py)",
+        f"  plate_pressure_floor_mmHg: {FSI_3D_PLATE_PRESSURE_RESERVE_MMHG:g}",
+        "  plate_pressure_floor_once_reached: true",
         f"  thin_walls {{ load_smoothing_radius_ratio: {FSI_3D_LOAD_SMOOTHING_RADIUS_RATIO:g} }}",
         f"  domain_lower: {_vec([-margin if sector else -R_tube - margin, -margin if sector else -R_tube - margin, tube_start - margin])}",
         f"  domain_upper: {_vec([R_tube + margin, R_tube + margin, tube_end + margin])}",

@@ -51,6 +51,18 @@ class ClosedLoad(unittest.TestCase):
         # smooth: the largest step per ms is the cosine ramp's, pi/2 * dp / (ramp in ms)
         self.assertLess(np.max(np.diff(ramp)), 1.01 * np.pi / 2 * largest / (closed_load.RAMP_S * 1e3))
 
+    def test_the_ventricle_rises_to_the_cycles_pressure_reserve(self):
+        # the cycle's plates hold the lower one at its reserve once engaged (tube_case), so the
+        # scene's ventricle ends there above its start (gauge 0), the aorta the difference higher
+        from valve_scene.tube_case import FSI_3D_PLATE_PRESSURE_RESERVE_MMHG as reserve
+        text = closed_load.case_text("FSI", case_text(CaseSpec("FSI", "MHGO", "sector", "coarse")))
+        t, lv, ao = (_table(text, f) for f in ("time_s", "ventricular_pressure_mmHg", "aortic_pressure_mmHg"))
+        self.assertGreater(reserve, 0.0)
+        np.testing.assert_allclose(lv[t >= closed_load.RAMP_S] - lv[0], reserve, atol=0.01)
+        self.assertTrue(np.all(np.diff(lv[t <= closed_load.RAMP_S]) >= 0))
+        self.assertIn(f"plate_pressure_floor_mmHg: {reserve:g}\n", text)
+        self.assertIn("plate_pressure_floor_once_reached: true\n", text)
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -245,6 +245,11 @@ class Channel2D:
     # in the reference), so the open leaflets swing into the sinus, the 36.8 mm channel, and the
     # backflow can get behind them (against a stent face they stayed open, docs/fsi-2d.md)
     stent_end: float = 0.0
+    # the fluid's gasket blocks reach this far past the annulus (rounded to whole spacings, at least
+    # one): the attached leaflet end then lies on the block's face, not at its corner, where the
+    # closed valve leaked round it (57 of the 58 cm^2/s per cm through it in diastole, 9 with the
+    # seal; docs/fsi-2d.md, session 10)
+    gasket_seal: float = 1.0e-3
     upstream_length: float = TubeSetup().upstream_length        # leaflet base -> inlet plate
     downstream_length: float = TubeSetup().downstream_length    # leaflet base -> outlet plate
     upstream_tap_distance: float = TubeSetup().upstream_tap_distance      # 1 valve diameter
@@ -253,6 +258,9 @@ class Channel2D:
     # flow-rate sections (x, m): upstream tap, stent inflow, 30 mm downstream, downstream tap
     flow_sections: tuple = field(default=(-23.0e-3, -3.0e-3, 30.0e-3, 69.0e-3))
     plate_travel_per_cycle: float = 60.0e-3   # allowance; the lumped estimate is ~5 cm (docs)
+    # room behind the inlet plate: diastolic leakage and the fluid's void push it back upstream
+    # (11 mm past its start at 0.6 s in session 9's xcoarse run, which then lost particles round it)
+    inlet_retreat_per_cycle: float = 20.0e-3
 
     def validate(self) -> None:
         checks = [
@@ -266,6 +274,8 @@ class Channel2D:
             ("flow_sections", all(-self.upstream_length < x < self.downstream_length for x in self.flow_sections),
              "every x in (-upstream_length, downstream_length)"),
             ("plate_travel_per_cycle", self.plate_travel_per_cycle >= 0, ">= 0"),
+            ("inlet_retreat_per_cycle", self.inlet_retreat_per_cycle >= 0, ">= 0"),
+            ("gasket_seal", 0 <= self.gasket_seal < self.downstream_length, "in [0, downstream_length)"),
         ]
         for name, ok, allowed in checks:
             if not ok:
@@ -330,7 +340,12 @@ def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Chann
     half = 0.5 * ch.width
     plate = 3 * dp
     x_in, x_out = -ch.upstream_length, ch.downstream_length
-    channel_start = x_in - plate - 2 * dp
+    channel_start = x_in - plate - cycles * ch.inlet_retreat_per_cycle - 2 * dp
+    gasket_end = ch.stent_end + max(1, round(ch.gasket_seal / dp)) * dp
+    # each plate stops the run before it leaves the channel (its back 2 dp inside the tube's end)
+    # or reaches the gasket (2 dp short of it)
+    inlet_range = [-cycles * ch.inlet_retreat_per_cycle, ch.stent_start - x_in - 2 * dp]
+    outlet_range = [-cycles * ch.plate_travel_per_cycle, x_out - gasket_end - 2 * dp]
     channel_end = x_out + plate + cycles * ch.plate_travel_per_cycle + 2 * dp
     margin = 6 * dp
     offset = aortic_pressure_at_opening_mmHg()
@@ -369,20 +384,24 @@ def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Chann
         f"  # the stent faces y = +-R lie on lattice planes (the channel walls {wall_offset * 1e3:.2g} mm off them)",
         f"  lattice_origin: {_vec([0.0, -ch.stent_radius])}",
         f"  fluid_blocks {{ box {{ lower: {_vec([x_in, -half])} upper: {_vec([x_out, half])} }} }}",
-        f"  # the ISO tube's section: a {ch.width * 1e3:.1f} mm channel, extended past the outlet plate by its travel",
+        f"  # the ISO tube's section: a {ch.width * 1e3:.1f} mm channel, extended behind the inlet plate and past the",
+        "  # outlet plate by their travel",
         f"  walls {{ tube {{ origin: {_vec([channel_start, 0])} axis: [1, 0] length: {channel_end - channel_start:.6g} radius: {half:.6g} }} }}",
-        f"  # gasket + skirt: rigid blocks narrowing the channel to the {2 * ch.stent_radius * 1e3:.0f} mm orifice, gasket face to the annulus",
-        f"  walls {{ solid_box {{ lower: {_vec([ch.stent_start, ch.stent_radius])} upper: {_vec([ch.stent_end, wall_top])} }} }}",
-        f"  walls {{ solid_box {{ lower: {_vec([ch.stent_start, -wall_top])} upper: {_vec([ch.stent_end, -ch.stent_radius])} }} }}",
+        f"  # gasket + skirt: rigid blocks narrowing the channel to the {2 * ch.stent_radius * 1e3:.0f} mm orifice, to {(gasket_end - ch.stent_end) * 1e3:.2f} mm",
+        "  # past the annulus so that the attached leaflet ends lie on their faces (sealed, valve2d.py)",
+        f"  walls {{ solid_box {{ lower: {_vec([ch.stent_start, ch.stent_radius])} upper: {_vec([gasket_end, wall_top])} }} }}",
+        f"  walls {{ solid_box {{ lower: {_vec([ch.stent_start, -wall_top])} upper: {_vec([gasket_end, -ch.stent_radius])} }} }}",
         "  # inlet plate: left-ventricular pressure",
         "  plates {",
         f"    shape {{ solid_box {{ lower: {_vec([x_in - plate, -half])} upper: {_vec([x_in, half])} }} }}",
         f"    normal: [1, 0] area: {ch.width:.6g} pressure_source: VENTRICULAR pressure_mmHg: {-offset:g}",
+        f"    travel_range: {_vec(inlet_range)}",
         "  }",
         "  # outlet plate: aortic pressure",
         "  plates {",
         f"    shape {{ solid_box {{ lower: {_vec([x_out, -half])} upper: {_vec([x_out + plate, half])} }} }}",
         f"    normal: [-1, 0] area: {ch.width:.6g} pressure_source: AORTIC pressure_mmHg: {-offset:g}",
+        f"    travel_range: {_vec(outlet_range)}",
         "  }",
         "  probes {",
         f"    pressure_points {{ name: \"upstream_tap\" position: {_vec([-ch.upstream_tap_distance, 0])} }}",

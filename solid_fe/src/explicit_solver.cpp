@@ -589,6 +589,7 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
     state_.energy.update_largest_energy();
     if (step_observer_) step_observer_(state_);
     if (options_.max_energy_balance_error > 0.0 && state_.step >= kEnergyCheckFirstStep) check_energy_growth();
+    if (automatic()) update_slow_velocity(dt);
     if (automatic() && settled_for_implicit()) {
       // The implicit integrator starts from x, v at this step and the acceleration of the
       // equation of motion there, with its first step (the settled state's own steps follow).
@@ -596,6 +597,7 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
       state_.acceleration.resize(3, 0);
       state_.implicit_step = 0;
       state_.implicit_switch_pressure = pressure_ ? pressure_(state_.time) : 0.0;
+      state_.chatter_damped = false;
       ++state_.switches;
       drop_kept_tangent();
     }
@@ -607,10 +609,27 @@ int ExplicitSolver::pressure_sign(double t) const {
   return (p > 0.0) - (p < 0.0);
 }
 
+void ExplicitSolver::update_slow_velocity(double h) {
+  const double tau = options_.settled_filter_time;
+  if (tau <= 0.0) return;
+  Eigen::Matrix3Xd& slow = state_.slow_velocity;
+  if (slow.cols() != state_.velocity.cols()) {
+    slow = state_.velocity;
+  } else {
+    // Backward Euler of d(slow)/dt = (v - slow) / tau: stable for any step, explicit or implicit.
+    slow += (h / (tau + h)) * (state_.velocity - slow);
+  }
+  double kinetic = 0.0;
+  for (Eigen::Index i = 0; i < slow.cols(); ++i) kinetic += 0.5 * elements_->nodal_mass()(i) * slow.col(i).squaredNorm();
+  state_.slow_kinetic = kinetic;
+}
+
 bool ExplicitSolver::settled_for_implicit() {
   const EnergyBalance& e = state_.energy;
   // A model that holds no strain energy (at rest and unloaded, or still starting) is not settled.
-  const bool settled = e.strain_energy > energy_check_floor_ && e.kinetic <= options_.settled_kinetic_ratio * e.strain_energy;
+  const bool settled =
+      e.strain_energy > energy_check_floor_ &&
+      (options_.settled_filter_time > 0.0 ? state_.slow_kinetic : e.kinetic) <= options_.settled_kinetic_ratio * e.strain_energy;
   if (!settled) {
     state_.settled_since = -1.0;
     return false;
@@ -619,11 +638,18 @@ bool ExplicitSolver::settled_for_implicit() {
   return state_.time - state_.settled_since >= options_.settled_hold;
 }
 
-bool ExplicitSolver::moving_again() const {
+bool ExplicitSolver::moving_again() {
   const EnergyBalance& e = state_.energy;
   const double at_switch = state_.implicit_switch_pressure;
-  return pressure_sign(state_.time) != (at_switch > 0.0) - (at_switch < 0.0) ||
-         e.kinetic > options_.moving_kinetic_ratio * e.strain_energy;
+  if (pressure_sign(state_.time) != (at_switch > 0.0) - (at_switch < 0.0)) return true;
+  const double moving = options_.moving_kinetic_ratio * e.strain_energy;
+  if (options_.settled_filter_time <= 0.0) return e.kinetic > moving;
+  if (state_.slow_kinetic > moving) return true;
+  if (!state_.chatter_damped) {
+    state_.chatter_damped = e.kinetic <= moving;
+    return false;
+  }
+  return e.kinetic > moving;
 }
 
 void ExplicitSolver::switch_to_explicit() {

@@ -320,6 +320,7 @@ void ExplicitSolver::advance_window_implicit(double t_end, const Eigen::Matrix3X
       state_.energy.update_largest_energy();
       if (step_observer_) step_observer_(state_);
       if (options_.max_energy_balance_error > 0.0 && state_.step >= kEnergyCheckFirstStep) check_energy_growth();
+      if (automatic()) update_slow_velocity(step);
       if (automatic() && moving_again()) {
         switch_to_explicit();
         return;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <fstream>
 #include <stdexcept>
 
@@ -132,6 +133,12 @@ void SeriesWriter::sample(const ExplicitSolver& solver, double pressure_Pa) {
   columns_["time"].push_back(s.time);
   columns_["step"].push_back(static_cast<double>(s.step));
   columns_["time_step"].push_back(s.stable_step);
+  // Which integrator took the last step and what the run has cost so far (process CPU, all
+  // threads): AUTOMATIC's phases and their cost read off the series.
+  columns_["implicit"].push_back(solver.implicit() ? 1.0 : 0.0);
+  columns_["newton_iterations"].push_back(static_cast<double>(s.newton_iterations));
+  columns_["cpu_time_s"].push_back(static_cast<double>(std::clock()) / CLOCKS_PER_SEC);
+  if (solver.automatic()) columns_["energy/slow_kinetic"].push_back(s.slow_kinetic);
   // Where the step comes from: the dt last used (growth limit and contact included), the element
   // that bounds it, the factor the calibration applies to the element bound, and the factor the
   // Lanczos step alone (2 / omega_max) would allow at the last calibration.

@@ -107,6 +107,9 @@ void write_solver_restart(const ExplicitSolver& solver, coupling::RestartWriter&
   file.put("solid/settled_since", s.settled_since);
   file.put("solid/implicit_switch_pressure", s.implicit_switch_pressure);
   file.put_integer("solid/switches", s.switches);
+  put_matrix(file, "solid/slow_velocity", s.slow_velocity);
+  file.put("solid/slow_kinetic", s.slow_kinetic);
+  file.put_integer("solid/chatter_damped", s.chatter_damped ? 1 : 0);
 }
 
 void write_solver_restart(const ExplicitSolver& solver, const std::filesystem::path& file) {
@@ -175,6 +178,12 @@ void read_solver_restart(const coupling::RestartReader& file, ExplicitSolver& so
     s.settled_since = file.scalar("solid/settled_since");
     s.implicit_switch_pressure = file.scalar("solid/implicit_switch_pressure");
     s.switches = file.integer("solid/switches");
+  }
+  // (files before the eleventh session: no filtered velocity; the filter restarts from v)
+  if (file.has("solid/slow_velocity")) {
+    s.slow_velocity = get_nodes(file, "solid/slow_velocity", n, true);
+    s.slow_kinetic = file.scalar("solid/slow_kinetic");
+    s.chatter_damped = file.integer("solid/chatter_damped") != 0;
   }
   const auto pairs = file.integers("solid/contact_candidates/pairs");
   s.contact_candidates.pairs.clear();

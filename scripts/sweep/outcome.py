@@ -93,6 +93,45 @@ def _reached(run_dir: Path) -> float | None:
     return None
 
 
+# what each program left on disk, in the order a reader of a failed run looks for it: (label, file,
+# where the times are: a dataset, or the "time" attribute of the file's snapshot groups)
+WRITTEN = (("interface series", "coupling_series.h5", "time"),
+           ("solid series", "solid_series.h5", "time"),
+           ("solid snapshot", "solid_fields.h5", "snapshots"),
+           ("fluid probes", "fluid_probes.h5", "time"),
+           ("fluid snapshot", "fluid_particles.h5", ""))
+
+
+def last_written(run_dir: Path) -> dict:
+    """{label: the latest time (s) in that file, or None when the file is missing, unreadable or
+    empty}: the last state a failed run left behind, per program and kind (WRITTEN)."""
+    import h5py
+    out = {}
+    for label, name, where in WRITTEN:
+        latest = None
+        try:
+            with h5py.File(Path(run_dir) / name, "r") as f:
+                if where == "time":
+                    t = f["time"][...]
+                    latest = float(np.max(t)) if len(t) else None
+                else:
+                    groups = f[where] if where else f
+                    times = [float(g.attrs["time"]) for g in groups.values()
+                             if isinstance(g, h5py.Group) and "time" in g.attrs]
+                    latest = max(times) if times else None
+        except (OSError, KeyError):
+            latest = None
+        out[label] = latest
+    return out
+
+
+def last_written_text(written: dict | None) -> str:
+    """'interface series 11.93 ms, ..., fluid probes missing' for the table."""
+    if not written:
+        return "–"
+    return ", ".join(f"{label} " + ("missing" if t is None else f"{t * 1e3:.2f} ms") for label, t in written.items())
+
+
 def _coupling_series(run_dir: Path):
     import h5py
     try:

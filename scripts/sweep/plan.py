@@ -136,6 +136,8 @@ def measure(run_dir: Path, work: Path, scene: str, setting: dict, end_time: floa
                                      leaks=measured.get("leaks"), max_edge_speed=measured.get("max_edge_speed"),
                                      edge_speed_at=((measured["max_edge_speed_time"], measured["max_edge_speed_where_mm"])
                                                     if "max_edge_speed_where_mm" in measured else None))
+    # what a failed run left to restart from or to look at (docs/stability-map.md's last column)
+    measured["last_written"] = outcome_module.last_written(run_dir)
     return measured, ending
 
 

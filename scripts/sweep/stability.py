@@ -72,8 +72,9 @@ def markdown(results: list[dict], order: list | None = None) -> str:
     if results:
         lines += [f"Span: {results[0].get('span') or results[0]['end_time']}.", ""]
     lines += ["| group | setting | μ | dp / t | end | reached (ms) | stopped by | message or measure "
-              "| max edge speed (m/s) | max interface force (N/m) | leaks | wall (s) | CPU (s) | load |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+              "| max edge speed (m/s) | max interface force (N/m) | leaks | wall (s) | CPU (s) | load "
+              "| last state written (failed runs) |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for group, members in groups_of(results, order).items():
         axis = varied_axis(members) or "setting"
         for r in sorted(members, key=lambda r: (str(type(_value(r, axis))), _value(r, axis))):
@@ -88,7 +89,8 @@ def markdown(results: list[dict], order: list | None = None) -> str:
                          f"{o['detected_by'] or '(not stopped)' if o['kind'] != 'completed' else ''} | {detail} | "
                          f"{_num(r['metrics'].get('max_edge_speed'))} | {_num(r['metrics'].get('max_interface_force'))} | "
                          f"{r['metrics'].get('leaks', '–')} | "
-                         f"{r['cost']['wall_s']:.0f} | {r['cost']['cpu_s']:.0f} | {report.load_text(r['cost'])} |")
+                         f"{r['cost']['wall_s']:.0f} | {r['cost']['cpu_s']:.0f} | {report.load_text(r['cost'])} | "
+                         f"{'' if o['kind'] == 'completed' else outcome.last_written_text(r['metrics'].get('last_written'))} |")
     return "\n".join(lines) + "\n"
 
 

@@ -359,6 +359,47 @@ class Classify(unittest.TestCase):
         self.assertEqual(outcome.classify(self.dir, 0, 0.1).kind, "other")
 
 
+class LastWritten(unittest.TestCase):
+    """What a failed run left on disk, per program: the latest time in each series and snapshot
+    file, and 'missing' for a file that was never written (session 4's c0 = 2.5 m/s collapse
+    left no fluid probe series at all)."""
+
+    def test_latest_time_of_each_file_and_missing_files(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            run = Path(tmp)
+            write_coupling(run, [0.001, 0.002, 0.0119], np.ones((3, 3)))
+            with h5py.File(run / "solid_series.h5", "w") as f:
+                f["time"] = np.array([0.0, 0.005, 0.0101])
+            with h5py.File(run / "solid_fields.h5", "w") as f:
+                for k, t in enumerate((0.0, 0.01)):
+                    f.create_group(f"snapshots/{k:06d}").attrs["time"] = t
+            with h5py.File(run / "fluid_particles.h5", "w") as f:
+                for k, t in enumerate((0.01, 0.0)):   # the order of the groups is not the order in time
+                    f.create_group(f"snapshot_{k:06d}").attrs["time"] = t
+            written = outcome.last_written(run)
+            self.assertEqual(list(written), ["interface series", "solid series", "solid snapshot", "fluid probes",
+                                             "fluid snapshot"])
+            self.assertAlmostEqual(written["interface series"], 0.0119)
+            self.assertAlmostEqual(written["solid series"], 0.0101)
+            self.assertAlmostEqual(written["solid snapshot"], 0.01)
+            self.assertIsNone(written["fluid probes"])
+            self.assertAlmostEqual(written["fluid snapshot"], 0.01)
+            text = outcome.last_written_text(written)
+            self.assertIn("interface series 11.90 ms", text)
+            self.assertIn("fluid probes missing", text)
+
+    def test_the_stability_table_shows_it_for_failed_runs_only(self):
+        written = {"interface series": 0.0119, "solid series": None}
+        failed = fake_result("1", 10, {"last_written": written}, kind="energy growth")
+        sound = fake_result("2", 10, {"last_written": written})
+        for r in (failed, sound):
+            r["setting"] = {"material": "MHGO", "sound_speed": float(r["label"]) * 10}
+        rows = [row for row in stability.markdown([failed, sound]).splitlines() if row.startswith("| grid")]
+        self.assertEqual(len(rows), 2)
+        self.assertTrue(rows[0].endswith("| interface series 11.90 ms, solid series missing |"), rows[0])
+        self.assertTrue(rows[1].endswith("|  |"), rows[1])
+
+
 def fake_result(label, cpu, m, kind="completed"):
     return {"label": label, "groups": ["grid"], "setting": {"spacing_mm": label}, "end_time": 0.12, "span": "s",
             "cost": {"wall_s": cpu, "cpu_s": cpu, "cpu_s_by_program": {"fluid": cpu}, "peak_rss_mb_by_program": {}}, "core_hours": cpu / 3600,
@@ -414,8 +455,9 @@ class MachineLoad(unittest.TestCase):
             r["metrics"].update(max_edge_speed=0.5, max_interface_force=3.0, leaks=0)
         rows = stability.markdown([loaded, old]).splitlines()
         self.assertIn("| load |", rows[2])
-        self.assertEqual(sum(row.endswith("| 3.2–7.5 |") for row in rows), 1)
-        self.assertEqual(sum(row.endswith("| – |") for row in rows), 1)
+        # the load column, then the last-state column (empty for completed runs)
+        self.assertEqual(sum(row.endswith("| 3.2–7.5 |  |") for row in rows), 1)
+        self.assertEqual(sum(row.endswith("| – |  |") for row in rows), 1)
 
 
 class Plan(unittest.TestCase):

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include "valvefsi/fluid/thin_wall/scenes_3d.hpp"
@@ -58,8 +59,10 @@ struct DiskFit {
   double in_phase = 0, velocity_phase = 0;
   std::size_t corrections = 0, leaks = 0;
 };
-DiskFit fit_disk(const OscillatingDisk& disk, double dp) {
-  ThinWallSolverRun3D flow(oscillating_disk_box(dp, disk));
+DiskFit fit_disk(const OscillatingDisk& disk, double dp, bool round_edge_state = false) {
+  ThinWallCase3D scene = oscillating_disk_box(dp, disk);
+  scene.wall_settings.fluid_state_round_free_edge = round_edge_state;
+  ThinWallSolverRun3D flow(std::move(scene));
   const double omega = 2.0 * std::numbers::pi / disk.period;
   const double symmetry = disk.quarter ? 4.0 : 1.0;
   std::vector<std::array<double, 4>> rows;
@@ -104,6 +107,21 @@ TEST(ThinWall3DMoving, OscillatingQuarterDiskAgainstPotentialAddedMass) {
   const DiskFit fit = fit_disk(disk, disk.radius / 5);
   EXPECT_EQ(fit.leaks, 0u);
   EXPECT_NEAR(fit.in_phase, 1.0, 0.1);
+}
+
+// The experiment fluid_state_round_free_edge (docs/thin-leaflet.md, session 11): virtual points
+// reached round the free edge carry the other side's state. On the quarter disk at a/dp = 5 it
+// takes most of the edge's excess away: over T-2T the in-phase coefficient was 1.62 by default
+// and 1.10 with the switch (one thread); the potential value in this box with the scene's 20-gon
+// rim is 0.985 of (8/3) rho a^3. (It also takes ~40 % of a static pressure jump off a 10 dp
+// membrane, thin_wall_3d_model_test, so it stays off.)
+TEST(ThinWall3DMoving, RoundEdgeStateTakesMostOfTheQuarterDisksEdgeExcessAway) {
+  omp_set_num_threads(2);
+  OscillatingDisk disk;
+  disk.quarter = true;
+  const DiskFit fit = fit_disk(disk, disk.radius / 5, true);
+  EXPECT_EQ(fit.leaks, 0u);
+  EXPECT_NEAR(fit.in_phase, 1.0, 0.2);  // the default's 1.62 is far outside
 }
 
 }  // namespace

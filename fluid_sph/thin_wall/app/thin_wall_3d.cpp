@@ -293,7 +293,10 @@ int main(int argc, char** argv) {
   app.add_option("--load-smoothing", smoothing_ratio, "with --case: node-load smoothing radius / dp (default: the case's)");
   app.add_flag("--aligned-layers", aligned, "virtual layers continue the particle's own lattice through the wall");
   bool no_lattice_beyond_edge = false;
+  bool round_edge_state = false;
   app.add_flag("--no-lattice-beyond-edge", no_lattice_beyond_edge, "no virtual lattice for particles beyond the free edge");
+  app.add_flag("--round-edge-state", round_edge_state,
+               "virtual points reached round a free edge carry the other side's pressure and fluid velocity");
   CLI11_PARSE(app, argc, argv);
   if (!case_file.empty()) return run_case_at_rest(case_file, surface_file, steps, no_surface, aligned, behind_only, relax_cycles, relax_steps,
                                                    smoothing_ratio);
@@ -306,6 +309,7 @@ int main(int argc, char** argv) {
   c.wall_settings.particle_aligned_layers = aligned;
   c.wall_settings.lattice_in_front = !behind_only;
   c.wall_settings.lattice_beyond_free_edge = !no_lattice_beyond_edge;
+  c.wall_settings.fluid_state_round_free_edge = round_edge_state;
   std::ofstream csv;
   if (!output.empty()) {
     csv.open(output);

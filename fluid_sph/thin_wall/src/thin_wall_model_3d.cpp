@@ -89,6 +89,45 @@ bool crosses_any_within(const TriangleMesh& mesh, const std::vector<std::uint32_
   return false;
 }
 
+// Length of the shortest path from a to b through a point of the segment [p, q]. The sum of the
+// two distances is convex along the segment, so a golden-section search finds its minimum
+// (to 1e-6 of the segment, far below dp for the path's use: reachable round a free edge).
+double path_through_segment(const Vec3& a, const Vec3& b, const Vec3& p, const Vec3& q) {
+  const Vec3 e = sub(q, p);
+  auto length = [&](double t) {
+    const Vec3 x{p[0] + t * e[0], p[1] + t * e[1], p[2] + t * e[2]};
+    return norm(sub(a, x)) + norm(sub(b, x));
+  };
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double lo = 0.0, hi = 1.0;
+  double t1 = hi - g * (hi - lo), t2 = lo + g * (hi - lo);
+  double f1 = length(t1), f2 = length(t2);
+  while (hi - lo > 1e-6) {
+    if (f1 <= f2) {
+      hi = t2;
+      t2 = t1;
+      f2 = f1;
+      t1 = hi - g * (hi - lo);
+      f1 = length(t1);
+    } else {
+      lo = t1;
+      t1 = t2;
+      f1 = f2;
+      t2 = lo + g * (hi - lo);
+      f2 = length(t2);
+    }
+  }
+  return std::min({f1, f2, length(0.0), length(1.0)});
+}
+
+// Distance from x to the segment [p, q].
+double distance_to_segment(const Vec3& x, const Vec3& p, const Vec3& q) {
+  const Vec3 e = sub(q, p), d = sub(x, p);
+  const double ee = dot(e, e);
+  const double t = ee > 0 ? std::clamp(dot(d, e) / ee, 0.0, 1.0) : 0.0;
+  return norm(sub(d, {t * e[0], t * e[1], t * e[2]}));
+}
+
 }  // namespace
 
 std::size_t orient_consistently(std::vector<std::array<std::uint32_t, 3>>& triangles) {
@@ -554,6 +593,7 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
       Vec3* forces = per_thread.data() + static_cast<std::size_t>(omp_get_thread_num()) * node_count_;
       std::vector<double> side_a;  // signed distance of the particle from each candidate's plane
       std::vector<ClosestPoint3> sheets;
+      std::vector<std::array<Vec3, 2>> free_edges;
       // Static chunks: each thread's share, and so the node loads' summation order, is the
       // same in every run with the same thread count (restarts continue bit for bit).
 #pragma omp for schedule(static, 16)
@@ -572,6 +612,13 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
         const Vec3 vva{p.viscous_velocity[0][a], p.viscous_velocity[1][a], p.viscous_velocity[2][a]};
         double acc[3] = {0, 0, 0}, cont = 0, csum = 0, cg[3] = {0, 0, 0};
         std::vector<std::uint32_t> one(1);
+        // The free edges within the support (experiment fluid_state_round_free_edge).
+        free_edges.clear();
+        if (settings_.fluid_state_round_free_edge)
+          for (const std::uint32_t t : cand)
+            for (std::size_t e = 0; e < 3; ++e)
+              if (mesh_.edge_on_boundary[t][e])
+                free_edges.push_back({mesh_.position[mesh_.triangles[t][e]], mesh_.position[mesh_.triangles[t][(e + 1) % 3]]});
         // One lattice behind each sheet (connected piece of the mesh with its images) within
         // the support: the nearest, and another facing the particle across a narrow gap (the
         // leaflet and its image in the coaptation plane 0.56 dp apart: a particle between them
@@ -661,12 +708,22 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
               const std::size_t t = hit->triangle;
               const auto& tri = mesh_.triangles[t];
               const int map = triangle_map_[t];
+              // Reachable round a free edge within the support: the fluid there is the other
+              // side's, flowing round the edge, not fluid moving with the wall (the 2D plate's
+              // lever on the edge's excess, docs/thin-leaflet.md).
+              bool round_edge = false;
+              for (std::size_t e = 0; e < free_edges.size() && !round_edge; ++e) {
+                const auto& [e0, e1] = free_edges[e];
+                if (distance_to_segment(xa, e0, e1) + distance_to_segment(xv, e0, e1) >= R) continue;
+                round_edge = path_through_segment(xa, xv, e0, e1) < R;
+              }
+              const int k_state = round_edge ? 1 - k_side : k_side;
               Vec3 q{0, 0, 0}, vw{0, 0, 0}, aw{0, 0, 0}, ve{0, 0, 0};
               double p_v = 0;
               for (int k = 0; k < 3; ++k) {
                 const double w = hit->barycentric[static_cast<std::size_t>(k)];
                 const std::uint32_t m = tri[static_cast<std::size_t>(k)];
-                const SideState& st = s.state[origin_node_[m]].side[static_cast<std::size_t>(k_side)];
+                const SideState& st = s.state[origin_node_[m]].side[static_cast<std::size_t>(k_state)];
                 p_v += w * st.pressure;
                 const Vec3 vst = to_image(map, st.velocity);
                 for (int d = 0; d < 3; ++d) {
@@ -680,6 +737,7 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
               for (int d = 0; d < 3; ++d) p_v += rho0 * (fluid_.gravity[d] - aw[d]) * (xv[d] - q[d]);
               Vec3 vv_v;
               for (int d = 0; d < 3; ++d) vv_v[d] = 2.0 * vw[d] - ve[d];  // no-slip
+              if (round_edge) vw = vv_v = ve;  // moves with that side's fluid
               const double inv_v = 1.0 / (rho0 + eos.density_excess(p_v - fluid_.background_pressure));
               const double dist = std::sqrt(r2);
               const double F = W.gradient_factor(static_cast<float>(dist));

@@ -62,6 +62,11 @@ struct ThinWall3DSettings {
   // virtual lattice of a particle whose closest point is on the free edge (beyond it), where the
   // fluid hidden behind the leaflet really flows round the edge instead of moving with it.
   bool lattice_beyond_free_edge = true;
+  // Experiment on the same bias: a virtual point the particle reaches round a free edge within
+  // the support (|x_a - e| + |e - x_v| < R for a point e of the edge) carries the other side's
+  // pressure and moves with that side's fluid velocity (no mirror), in the momentum and the
+  // continuity equations (the 2D plate's --round-edge --round-edge-velocity).
+  bool fluid_state_round_free_edge = false;
 };
 
 // Consistent orientation of an open triangle mesh: flips triangles (per connected piece, from

@@ -175,6 +175,21 @@ TEST(ModelProblemsThroughCoupler, AcousticPistonSlowRunawayIsStoppedBelowTheSpee
   EXPECT_GT(read_series(unwatched.dir / "coupling_series.h5", "interface_oscillation").back(), 10.0 * blocks.back());
 }
 
+// The fluid moved with the solid's mean velocity over the previous window instead of its velocity
+// at the window's start (coupling.explicit_motion_velocity): one more half window of lag, a lower
+// serial limit. With the trapezoidal piston (docs/coupling-numerics.md (b)), A = dt a and s the
+// velocity sent: A_{n+1} = -mu s_n, v_{n+1} = v_n + (A_n + A_{n+1}) / 2, s_{n+1} = (v_n + v_{n+1}) / 2;
+// the spectral radius of that map reaches 1 at mu = 4/3 (the window's velocity: mu = 2).
+TEST(ModelProblemsThroughCoupler, AcousticPistonSerialExplicitWithTheMeanVelocityHasTheLimitMuFourThirds) {
+  const std::string scheme = "scheme: SERIAL_EXPLICIT explicit_motion_velocity: PREVIOUS_WINDOW_MEAN";
+  const double limit = 4.0 / 3.0;
+  const auto stable = acoustic("mp-serial-mean-stable", scheme, 0.97 * limit, 3000);
+  ASSERT_TRUE(all_ok(stable)) << stable.coupler_log;
+  EXPECT_NEAR(value_after(stable.solid_log, "final u = [-+0-9.eE]+ m, v"), kTerminalVelocity, 1e-6 * kTerminalVelocity);
+  const auto unstable = acoustic("mp-serial-mean-unstable", scheme, 1.03 * limit, 3000);
+  EXPECT_TRUE(stopped_as_runaway(unstable)) << unstable.coupler_log;
+}
+
 TEST(ModelProblemsThroughCoupler, AcousticPistonParallelExplicitFailsEarlier) {
   const auto stable = acoustic("mp-parallel-stable", "scheme: PARALLEL_EXPLICIT", 0.97 * kParallelLimit, 4000);
   ASSERT_TRUE(all_ok(stable)) << stable.coupler_log;

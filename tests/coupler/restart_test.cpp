@@ -120,6 +120,12 @@ TEST(CouplerRestart, SerialExplicitContinuesBitForBit) {
                                "t_0.010000000", 0.02, 200);
 }
 
+// The previous window's mean velocity is carried in the coupler's restart file.
+TEST(CouplerRestart, SerialExplicitWithThePreviousWindowsMeanVelocityContinuesBitForBit) {
+  expect_continues_bit_for_bit("scheme: SERIAL_EXPLICIT explicit_motion_velocity: PREVIOUS_WINDOW_MEAN",
+                               "restart-explicit-mean", 1.0, 0.005, "t_0.010000000", 0.02, 200);
+}
+
 TEST(CouplerRestart, ImplicitIqnIlsContinuesBitForBitWithItsReusedColumns) {
   // mu = 10 (beyond both explicit limits): IQN-ILS still iterates in the transient and carries
   // columns from past windows; 80 windows, points at 1, 2, 3 ms; resume from 1 ms.

@@ -49,29 +49,41 @@ struct Proposals {
   double solid = 0.0;
 };
 
-WindowRecord serial_explicit_window(WindowExchange& exchange, const WindowSpan& window, SolidState& solid,
+// The velocity the fluid's points move with through the next explicit window: the solid's at
+// the window's end, or its mean over the window (coupling.explicit_motion_velocity).
+Eigen::Matrix3Xd next_motion_velocities(const CouplerSettings& settings, const WindowSpan& window,
+                                        const SolidState& start, const SolidState& end) {
+  if (!settings.explicit_motion_previous_window_mean) return end.velocities;
+  return (end.positions - start.positions) / window.size;
+}
+
+WindowRecord serial_explicit_window(WindowExchange& exchange, const CouplerSettings& settings,
+                                    const WindowSpan& window, SolidState& solid, Eigen::Matrix3Xd& motion_velocities,
                                     Proposals& proposals) {
-  const auto fluid_velocities = exchange.send_motion_to_fluid(window, solid.positions, solid.velocities);
+  const auto fluid_velocities = exchange.send_motion_to_fluid(window, solid.positions, motion_velocities);
   const auto fluid = exchange.receive_fluid();
   const Eigen::Matrix3Xd node_forces = exchange.loads_to_nodes(fluid.forces);
   exchange.send_loads_to_solid(window, node_forces);
   auto reply = exchange.receive_solid();
   WindowRecord record;
-  fill_record(record, window, fluid.forces, fluid_velocities, node_forces, solid.velocities);
+  fill_record(record, window, fluid.forces, fluid_velocities, node_forces, motion_velocities);
+  motion_velocities = next_motion_velocities(settings, window, solid, reply.state);
   record.load_work_solid = load_work(node_forces, solid, reply.state);
   solid = std::move(reply.state);
   proposals = {fluid.max_stable_window, reply.max_stable_window};
   return record;
 }
 
-WindowRecord parallel_explicit_window(WindowExchange& exchange, const WindowSpan& window, SolidState& solid,
+WindowRecord parallel_explicit_window(WindowExchange& exchange, const CouplerSettings& settings,
+                                      const WindowSpan& window, SolidState& solid, Eigen::Matrix3Xd& motion_velocities,
                                       Eigen::Matrix3Xd& previous_node_forces, Proposals& proposals) {
-  const auto fluid_velocities = exchange.send_motion_to_fluid(window, solid.positions, solid.velocities);
+  const auto fluid_velocities = exchange.send_motion_to_fluid(window, solid.positions, motion_velocities);
   exchange.send_loads_to_solid(window, previous_node_forces);
   const auto fluid = exchange.receive_fluid();
   auto reply = exchange.receive_solid();
   WindowRecord record;
-  fill_record(record, window, fluid.forces, fluid_velocities, previous_node_forces, solid.velocities);
+  fill_record(record, window, fluid.forces, fluid_velocities, previous_node_forces, motion_velocities);
+  motion_velocities = next_motion_velocities(settings, window, solid, reply.state);
   record.load_work_solid = load_work(previous_node_forces, solid, reply.state);
   previous_node_forces = exchange.loads_to_nodes(fluid.forces);
   solid = std::move(reply.state);
@@ -191,6 +203,9 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
   const auto& session = exchange.session();
   SolidState solid{session.solid_initial_positions, session.solid_initial_velocities};
   Eigen::Matrix3Xd previous_node_forces = Eigen::Matrix3Xd::Zero(3, session.solid_surface.positions.cols());
+  // Explicit schemes: the velocity the fluid's points move with in the next window (window 0: the
+  // solid's initial velocity under either choice of coupling.explicit_motion_velocity).
+  Eigen::Matrix3Xd motion_velocities = solid.velocities;
   std::unique_ptr<coupling::Acceleration> acceleration;
   if (settings.scheme == SchemeKind::serial_implicit) acceleration = coupling::make_acceleration(settings.acceleration);
 
@@ -208,6 +223,7 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
     summary.unconverged_windows = state.unconverged_windows;
     solid = {state.solid_positions, state.solid_velocities};
     previous_node_forces = state.previous_node_forces;
+    motion_velocities = state.motion_velocities;
     proposals = {state.fluid_proposal, state.solid_proposal};
     if (acceleration) acceleration->restore_carried_state(state.acceleration);
     spdlog::info("coupler: continuing from {} at t = {} s (window {})", settings.restart_from.string(), time, summary.windows);
@@ -227,17 +243,21 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
     if (settings.restart_interval > 0.0 && time >= next_restart * (1.0 - 1e-12)) {
       restart = coupling::restart_folder(settings.output_dir, time);
       CouplerRestartState state{time, summary.windows, summary.total_iterations, summary.unconverged_windows,
-                                solid.positions, solid.velocities, previous_node_forces, proposals.fluid,
-                                proposals.solid, acceleration ? acceleration->carried_state() : coupling::CarriedState{}};
+                                solid.positions, solid.velocities, previous_node_forces, motion_velocities,
+                                proposals.fluid, proposals.solid,
+                                acceleration ? acceleration->carried_state() : coupling::CarriedState{}};
       write_coupler_restart(restart, state);
       exchange.send_restart_write(time, restart);
       next_restart = next_restart_after(time);
     }
     WindowRecord record;
     switch (settings.scheme) {
-      case SchemeKind::serial_explicit: record = serial_explicit_window(exchange, window, solid, proposals); break;
+      case SchemeKind::serial_explicit:
+        record = serial_explicit_window(exchange, settings, window, solid, motion_velocities, proposals);
+        break;
       case SchemeKind::parallel_explicit:
-        record = parallel_explicit_window(exchange, window, solid, previous_node_forces, proposals);
+        record = parallel_explicit_window(exchange, settings, window, solid, motion_velocities, previous_node_forces,
+                                          proposals);
         break;
       case SchemeKind::serial_implicit:
         record = serial_implicit_window(exchange, settings, window, solid, *acceleration, proposals);

@@ -19,6 +19,7 @@ void write_coupler_restart(const std::filesystem::path& folder, const CouplerRes
   file.put("solid_positions", state.solid_positions);
   file.put("solid_velocities", state.solid_velocities);
   file.put("previous_node_forces", state.previous_node_forces);
+  file.put("motion_velocities", state.motion_velocities);
   file.put("fluid_proposal", state.fluid_proposal);
   file.put("solid_proposal", state.solid_proposal);
   file.put("acceleration_integers", std::span<const std::int64_t>(state.acceleration.integers));
@@ -43,6 +44,8 @@ CouplerRestartState read_coupler_restart(const std::filesystem::path& folder,
   state.solid_positions = file.matrix3x("solid_positions", solid_nodes);
   state.solid_velocities = file.matrix3x("solid_velocities", solid_nodes);
   state.previous_node_forces = file.matrix3x("previous_node_forces", solid_nodes);
+  state.motion_velocities = file.has("motion_velocities") ? file.matrix3x("motion_velocities", solid_nodes)
+                                                        : state.solid_velocities;
   state.fluid_proposal = file.scalar("fluid_proposal");
   state.solid_proposal = file.scalar("solid_proposal");
   state.acceleration.integers = file.integers("acceleration_integers");

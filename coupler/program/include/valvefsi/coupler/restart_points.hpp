@@ -23,6 +23,9 @@ struct CouplerRestartState {
   Eigen::Matrix3Xd solid_positions;  // the solid's nodes at `time`
   Eigen::Matrix3Xd solid_velocities;
   Eigen::Matrix3Xd previous_node_forces;  // parallel explicit: the loads the solid gets next
+  // explicit: the velocity the fluid's points move with next (the solid's velocity, or its
+  // previous window's mean with coupling.explicit_motion_velocity); older files: solid_velocities
+  Eigen::Matrix3Xd motion_velocities;
   double fluid_proposal = 0.0;            // window sizes proposed for the next window (s)
   double solid_proposal = 0.0;
   coupling::CarriedState acceleration;

@@ -1,7 +1,9 @@
 // The coupled mode: the solid's mid-surface (3D) or strip front line (2D) is the interface; each
 // coupling window the fluid's forces are applied, constant over the window, while the explicit
-// solver sub-cycles to the window's end. Checkpoints are copies of the solver state. The case's
-// waveform is not applied: the fluid carries the load.
+// solver sub-cycles to the window's end (or, with time_integration IMPLICIT in 3D, generalized-alpha
+// steps land on it: its numerical damping takes out modes faster than the window, which the fluid
+// cannot damp). Checkpoints are copies of the solver state. The case's waveform is not applied:
+// the fluid carries the load.
 #include "participant_mode.hpp"
 
 #include <algorithm>
@@ -57,6 +59,9 @@ class CoupledOutput {
     }
     if (last) series_.flush();
   }
+  // A peer's stop: the samples taken since the last snapshot go to disk too (the state itself may
+  // be an iterate the coupler never accepted, so it is not sampled).
+  void flush() { series_.flush(); }
 
  private:
   static std::vector<std::pair<std::string, std::vector<std::int64_t>>> monitors_of(const SolidSetup& setup) {
@@ -89,11 +94,9 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
   SolidSetup setup = setup_from_case(c, case_file);
   for (const auto& note : setup.notes) spdlog::info("{}", note);
   ExplicitSolver& solver = *setup.solver;
-  if (solver.options().time_integration != TimeIntegration::explicit_central_difference) {
-    // Not yet tested against the coupler (checkpoints, restarts, 13 us windows): FE-only only.
-    spdlog::error("{}: field 'solid.time_integration' = {} in a coupled run: allowed only with --fe-only "
-                  "(coupled runs use EXPLICIT)", case_file.string(), solver.automatic() ? "AUTOMATIC" : "IMPLICIT");
-    return 2;
+  if (solver.implicit()) {
+    spdlog::info("coupled solid: implicit generalized-alpha steps (rho_inf = {}) of at most {:.3g} s, landing on "
+                 "each window's end", solver.options().spectral_radius_infinity, solver.options().max_time_step);
   }
   const SolidInterface interface =
       setup.dimension == 2 ? strip_interface(setup.mesh, setup.strip_ties, setup.strip_depth, setup.mesh_file.string())
@@ -114,8 +117,16 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
   options.liveness.startup_timeout = std::chrono::duration<double>(c.coupling().startup_timeout_s());
 
   std::unique_ptr<coupling::Participant> participant;
+  std::optional<CoupledOutput> output;
   try {
     participant = std::make_unique<coupling::Participant>(options);
+    if (solver.automatic()) {
+      // The switch reads the case's pressure waveform, which a coupled run does not apply. (Thrown
+      // after the participant exists, so that the coupler and the fluid are told at once.)
+      throw std::runtime_error(fmt::format("{}: field 'solid.time_integration' = AUTOMATIC in a coupled run: allowed "
+                                           "only with --fe-only (coupled runs use EXPLICIT or IMPLICIT)",
+                                           case_file.string()));
+    }
     solver.advance_window(0.0);  // forces and stable step of the initial state
     coupling::InterfaceMotion motion;
     interface.motion(solver.state(), motion.positions, motion.velocities);
@@ -134,7 +145,7 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
                    solver.state().step, output_suffix.empty() ? "files start at the restart time"
                                                               : "files named with suffix " + output_suffix);
     }
-    CoupledOutput output(c, output_dir, setup, output_suffix);
+    output.emplace(c, output_dir, setup, output_suffix);
     spdlog::info("coupled ({}D, {} interface nodes, {} cells) with {} {}, scheme {}; {} threads; output to {}",
                  setup.dimension, interface.nodes.size(), interface.cells.cols(),
                  participant->session().partner_solver_name, participant->session().partner_solver_version,
@@ -152,7 +163,7 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
         solver.restore(*checkpoint);
         ++repeats;
       } else if (have_unwritten_state) {
-        output.accepted(solver, false);
+        output->accepted(solver, false);
       }
       if (window.save_checkpoint) checkpoint = solver.state();
       if (window.write_restart) {
@@ -163,7 +174,7 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
         solver.advance_window(window.end(), &nodal_forces);
       } catch (const EnergyGrowthError& e) {
         // Write the state of the failing step as the last output, then stop as for a material failure.
-        output.accepted(solver, true);
+        output->accepted(solver, true);
         throw EnergyGrowthError(fmt::format("{} Kinetic energy's element: {}. The last sample and snapshot of {} hold "
                                             "this state.", e.what(),
                                             kinetic_energy_element(setup.mesh, setup.element_family, solver,
@@ -185,7 +196,7 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
                      std::chrono::duration<double>(now - wall_start).count());
       }
     }
-    output.accepted(solver, true);
+    output->accepted(solver, true);
     const SolverState& s = solver.state();
     const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
     spdlog::info("done: t = {} s, {} steps, {} repeated windows, wall time {:.1f} s ({:.3g} ms per step), "
@@ -198,6 +209,7 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
     return 0;
   } catch (const coupling::TransportError& e) {
     spdlog::error("{}", e.what());
+    if (output) output->flush();
     if (participant) participant->abort(e.what());
     return e.exit_code();
   } catch (const EnergyGrowthError& e) {
@@ -206,10 +218,12 @@ int run_participant(const cases::Case& c, const std::filesystem::path& case_file
     return kExitSolidFailure;
   } catch (const MaterialStateError& e) {
     spdlog::error("{}", e.what());
+    if (output) output->flush();
     if (participant) participant->abort(std::string("solid_fe: ") + e.what());
     return kExitSolidFailure;
   } catch (const std::runtime_error& e) {  // e.g. a restart file that does not fit this case
     spdlog::error("{}", e.what());
+    if (output) output->flush();
     if (participant) participant->abort(std::string("solid_fe: ") + e.what());
     return 2;
   }

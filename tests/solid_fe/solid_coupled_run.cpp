@@ -17,11 +17,14 @@ SolidCoupledRun::SolidCoupledRun(const SolidRunSpec& spec, bool fe_only)
   const auto case_file = dir / "case.textproto";
   valvefsi::testing::write_file(
       case_file,
-      fmt::format("run {{ end_time: {} output_dir: \"{}\" series_interval: 0.001 snapshot_interval: 0.005 {} }}\n"
+      fmt::format("run {{ end_time: {} output_dir: \"{}\" series_interval: 0.001 {} {} }}\n"
                   "{}\nsolid {{ mesh_file: \"strip.mesh.h5\" {} }}\n"
                   "coupling {{ endpoint: \"ipc://{}/c.ipc\" heartbeat_interval_s: 0.1 peer_timeout_s: 2 "
                   "startup_timeout_s: 30 {} }}\n",
-                  spec.end_time, dir.string(), spec.run_extra, spec.waveform, spec.solid_extra, dir.string(),
+                  spec.end_time, dir.string(),
+                  // run_extra may set its own snapshot interval (a field given twice is an error)
+                  spec.run_extra.find("snapshot_interval") == std::string::npos ? "snapshot_interval: 0.005" : "",
+                  spec.run_extra, spec.waveform, spec.solid_extra, dir.string(),
                   spec.coupling_extra));
   const std::vector<std::string> common = {"--case", case_file.string(), "--output", output.string()};
   auto with = [&](std::vector<std::string> argv, const std::vector<std::string>& extra) {

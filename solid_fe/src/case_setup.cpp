@@ -175,6 +175,12 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.max_energy_balance_error = solid.max_energy_balance_error();
   solver_options.fixed_time_step = solid.forced_time_step();
   solver_options.time_step_look_ahead = solid.time_step_look_ahead();
+  if (solid.settled_filter_time_s() > 0.0 && solid.time_integration() != cases::SolidCase::AUTOMATIC) {
+    throw CaseError(fmt::format("{}: field 'solid.settled_filter_time_s' = {} with solid.time_integration = {}: "
+                                "it filters the automatic switch's kinetic energy; allowed > 0 only with "
+                                "time_integration AUTOMATIC (0 otherwise)",
+                                source, solid.settled_filter_time_s(), integration));
+  }
   if (implicit) {
     if (setup.dimension == 2) {
       throw CaseError(fmt::format("{}: field 'solid.time_integration' = {} with run.dimension = 2: allowed "
@@ -191,6 +197,17 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
     solver_options.settled_kinetic_ratio = solid.settled_kinetic_ratio();
     solver_options.settled_hold = solid.settled_hold_s();
     solver_options.moving_kinetic_ratio = solid.moving_kinetic_ratio();
+    solver_options.settled_filter_time = solid.settled_filter_time_s();
+    if (solver_options.settled_filter_time > 0.0) {
+      setup.notes.push_back(fmt::format(
+          "automatic switch on the kinetic energy low-pass filtered over {} s (solid.settled_filter_time_s){}",
+          solver_options.settled_filter_time,
+          solid.spectral_radius_infinity() > 0.5
+              ? fmt::format("; with spectral_radius_infinity {} > 0.5 the implicit phases it starts in the "
+                            "moving leaflet were measured slower than explicit (docs/solid_fe.md)",
+                            solid.spectral_radius_infinity())
+              : ""));
+    }
     solver_options.spectral_radius_infinity = solid.spectral_radius_infinity();
     solver_options.implicit_initial_step = solid.implicit_initial_step_s();
     solver_options.implicit_min_step = solid.implicit_min_step_s();

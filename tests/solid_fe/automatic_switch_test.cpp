@@ -33,7 +33,8 @@ double pressure(double t) {
 }
 
 std::unique_ptr<ShellSolver> flap(TimeIntegration integration,
-                                  double settled_filter_time = SolverOptions{}.settled_filter_time) {
+                                  double settled_filter_time = SolverOptions{}.settled_filter_time,
+                                  double time_step_safety = SolverOptions{}.time_step_safety) {
   Mesh mesh = rectangular_plate(0.01, 0.005, 10, 5, kThickness);
   ShellModelOptions options;
   options.fixed_nodes = mesh.node_sets.at("left");
@@ -43,6 +44,7 @@ std::unique_ptr<ShellSolver> flap(TimeIntegration integration,
   o.implicit_initial_step = 1e-6;
   o.max_time_step = 1e-3;
   o.settled_filter_time = settled_filter_time;
+  o.time_step_safety = time_step_safety;
   auto solver = std::make_unique<ShellSolver>(build_shell_model(mesh, options), Material{Mhgo{}}, o);
   solver->set_pressure(pressure);
   solver->add_contact_plane({Eigen::Vector3d(0, 0, -0.3e-3), Eigen::Vector3d(0, 0, 1)});
@@ -55,8 +57,9 @@ struct FlapRun {
   std::vector<double> switch_times;    // AUTOMATIC: the times its phase changed
 };
 
-FlapRun run_flap(TimeIntegration integration, double settled_filter_time = SolverOptions{}.settled_filter_time) {
-  auto solver = flap(integration, settled_filter_time);
+FlapRun run_flap(TimeIntegration integration, double settled_filter_time = SolverOptions{}.settled_filter_time,
+                 double time_step_safety = SolverOptions{}.time_step_safety) {
+  auto solver = flap(integration, settled_filter_time, time_step_safety);
   FlapRun r;
   bool phase = false;
   solver->set_step_observer([&](const SolverState& s) {
@@ -112,34 +115,47 @@ TEST(AutomaticSwitch, PressedFlapSwitchesToImplicitAndBackWhenReleasedAndAgreesW
 // The switches on the kinetic energy of the velocity low-pass filtered over 1 ms: the pressed
 // flap's contact chatter (instantaneous kinetic energy above 5 % of the strain energy until ~22 ms)
 // is much faster than 1 ms, so the flap counts as settled as soon as it lies still on the plane.
+// All three runs take half the default explicit step (time_step_safety 0.4), so that the released
+// state compares the switch, not the explicit step error (below).
 TEST(AutomaticSwitch, FilteredKineticEnergySwitchesEarlierWithTheSameAnswer) {
-  const FlapRun filtered = run_flap(TimeIntegration::automatic, 1e-3);
-  const FlapRun instantaneous = run_flap(TimeIntegration::automatic, 0.0);
-  const FlapRun reference = run_flap(TimeIntegration::explicit_central_difference);
+  constexpr double kSafety = 0.4;
+  const FlapRun filtered = run_flap(TimeIntegration::automatic, 1e-3, kSafety);
+  const FlapRun instantaneous = run_flap(TimeIntegration::automatic, 0.0, kSafety);
+  const FlapRun reference = run_flap(TimeIntegration::explicit_central_difference, 0.0, kSafety);
   for (double t : filtered.switch_times) std::printf("  filtered: switch at %.4f ms\n", 1e3 * t);
   ASSERT_GE(filtered.switch_times.size(), 2u);
   ASSERT_GE(instantaneous.switch_times.size(), 2u);
   const double pressed = (filtered.pressed - reference.pressed).colwise().norm().maxCoeff();
   const double released = (filtered.released - reference.released).colwise().norm().maxCoeff();
-  std::printf("filtered vs explicit: pressed %.3g m, released %.3g m (%.3g / %.3g of the thickness); steps %lld "
-              "(instantaneous %lld, explicit %lld)\n", pressed, released, pressed / kThickness, released / kThickness,
+  const double released_instantaneous = (instantaneous.released - reference.released).colwise().norm().maxCoeff();
+  std::printf("filtered vs explicit: pressed %.3g m, released %.3g m (%.3g / %.3g of the thickness; instantaneous "
+              "switch released %.3g m); steps %lld (instantaneous %lld, explicit %lld)\n", pressed, released,
+              pressed / kThickness, released / kThickness, released_instantaneous,
               static_cast<long long>(filtered.steps_at_ms.back()), static_cast<long long>(instantaneous.steps_at_ms.back()),
               static_cast<long long>(reference.steps_at_ms.back()));
-  // Implicit 5 ms after the flap lies still (measured 6.9 ms; instantaneous 27.0 ms). It may come
+  // Implicit 5 ms after the flap lies still (measured 7.15 ms; instantaneous 26.88 ms). It may come
   // back to explicit while pressed when the instantaneous energy rises again after the implicit
-  // scheme had damped it (measured: 17.3 -> 22.3 ms), but the last switch is the release's,
-  // caught as early as without the filter (measured 60.10 ms).
+  // scheme had damped it (measured: 17.79 -> 22.80 ms), but the last switch is the release's,
+  // caught as early as without the filter (measured 60.09 ms).
   EXPECT_GT(filtered.switch_times[0], 5e-3);
   EXPECT_LT(filtered.switch_times[0], instantaneous.switch_times[0] - 10e-3);
   EXPECT_EQ(filtered.switch_times.size() % 2, 0u);
   EXPECT_LT(filtered.switch_times[filtered.switch_times.size() - 2], kRelease);
   EXPECT_GE(filtered.switch_times.back(), kRelease);
   EXPECT_LE(filtered.switch_times.back(), instantaneous.switch_times[1] + 1e-9);
-  // Bounds: 2 % of the thickness pressed (as above); released 3 % (7.5 um, 55x below the 0.41 mm
-  // travel; measured 5.0 um against the instantaneous switch's 3.4 um: the implicit scheme took
-  // the flap from 6.9 ms on, not 27 ms).
+  // Bounds: 2 % of the thickness pressed (as above; measured 0.024 um). Released 1 % (2.5 um;
+  // measured 0.49 um, the instantaneous switch 0.66 um), 160x below the 0.41 mm travel. Why half the
+  // step: after the release every run integrates explicitly, and at the default safety 0.8 the
+  // explicit step error is what the comparison sees. The explicit run itself moves 27.5 um at
+  // 75 ms when its step is halved (then 6.1 and 1.5 um per further halving: second order), and
+  // at 0.8 the filtered run's difference (5.0 um; instantaneous 3.4 um) scatters over 2.7-5.9 um
+  // when the Newton tolerance (1e-6 to 1e-10), the implicit step cap (1 ms to 20 us) or rho_inf
+  // (0.5 to 1) change, converging with none of them; with the step it falls (0.49 um at 0.4; at
+  // 0.2 the filtered run is 0.24 um from the explicit run at 0.1). docs/solid_fe.md, "The
+  // filtered switch's test bound".
   EXPECT_LT(pressed, 0.02 * kThickness);
-  EXPECT_LT(released, 0.03 * kThickness);
+  EXPECT_LT(released, 0.01 * kThickness);
+  EXPECT_LT(released_instantaneous, 0.01 * kThickness);
   EXPECT_LT(filtered.steps_at_ms.back(), instantaneous.steps_at_ms.back());
 }
 

@@ -88,6 +88,39 @@ TEST(CaseSetup, AutomaticSwitchIsReadWithItsThresholdsAndRefusedWhenTheyCross) {
   }
 }
 
+TEST(CaseSetup, SettledFilterTimeIsReadForAutomaticAndRefusedWithoutIt) {
+  const CaseFiles f = write_case("filter", "time_integration: AUTOMATIC settled_filter_time_s: 0.001 "
+                                           "spectral_radius_infinity: 0.5");
+  EXPECT_EQ(setup_from_case(load_case(f.case_file), f.case_file).shell_solver().options().settled_filter_time, 0.001);
+  const CaseFiles unset = write_case("filter_unset", "time_integration: AUTOMATIC");
+  EXPECT_EQ(setup_from_case(load_case(unset.case_file), unset.case_file).shell_solver().options().settled_filter_time,
+            0.0)
+      << "off unless asked for: the instantaneous switch is the default";
+  // Explicit and implicit runs have no switch to filter.
+  for (const std::string integration : {"EXPLICIT", "IMPLICIT"}) {
+    const CaseFiles refused = write_case("filter_" + integration,
+                                         "time_integration: " + integration + " settled_filter_time_s: 0.002");
+    try {
+      setup_from_case(load_case(refused.case_file), refused.case_file);
+      FAIL() << "settled_filter_time_s with " << integration << " must be refused";
+    } catch (const CaseError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(refused.case_file.string()), std::string::npos) << "names the file: " << what;
+      EXPECT_NE(what.find("solid.settled_filter_time_s' = 0.002"), std::string::npos) << what;
+      EXPECT_NE(what.find(integration), std::string::npos) << what;
+      EXPECT_NE(what.find("only with time_integration AUTOMATIC"), std::string::npos) << "what is allowed: " << what;
+    }
+  }
+  // The field's limits: negative time constants are refused by the loader, naming the field.
+  const CaseFiles negative = write_case("filter_negative", "time_integration: AUTOMATIC settled_filter_time_s: -0.001");
+  try {
+    setup_from_case(load_case(negative.case_file), negative.case_file);
+    FAIL() << "a negative filter time must be refused";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("settled_filter_time_s"), std::string::npos) << e.what();
+  }
+}
+
 TEST(CaseSetup, LeafletSelfContactIsReadAndRefusedForBricks) {
   // The plate has no leaflet_<k> sets: with self-contact the whole mesh is one leaflet.
   const CaseFiles f = write_case("self_contact", "leaflet_self_contact: true");

@@ -186,7 +186,8 @@ struct SolverOptions {
   // vibration; a release is then caught as fast as without the filter). 0: the instantaneous
   // kinetic energy throughout (docs/solid_fe.md, "Automatic switch"). Off by default: it pays
   // only with a dissipative scheme (spectral_radius_infinity 0.5: the coarse sector's cycle 171 ->
-  // 45 s CPU); with 0.8 the implicit open phase it starts crawls at ~1-3 us steps. No case field yet.
+  // 45 s CPU); with 0.8 the implicit open phase it starts crawls at ~1-3 us steps.
+  // Case field: solid.settled_filter_time_s.
   double settled_filter_time = 0;
 };
 

@@ -2,7 +2,8 @@
 on a sharp and a rounded mesh (docs/valve-scene.md, "Rounded commissure").
 
     cd scripts && /usr/bin/python3 -m valve_scene.commissure_check --out /work/runs/commissure \
-        [--radii 0 1e-3] [--resolution coarse] [--material MHGO] [--build-dir ../build]
+        [--radii 0 1e-3] [--resolution coarse] [--material MHGO] [--build-dir ../build] \
+        [--commissure-top-row 1 1]   # the sharp corner with uniform rows (before session 12)
 
 Each radius gets the sector mesh and a closing case (the solid's owner's refinement check,
 docs/solid_fe.md): aortic 80 mmHg ramped in over 5 ms against 0 ventricular, mass damping
@@ -51,7 +52,12 @@ def check_case(spec: CaseSpec, mesh_path: Path, closing: bool) -> str:
     text = case_text(spec)
     if closing:
         text = text.replace(waveform.waveform_textproto(), closing_waveform())
-        text = text.replace("  density: ", f"  mass_damping_per_s: {CLOSING_DAMPING_PER_S:g}\n  density: ", 1)
+        # the cycle cases carry their own (lighter) mass damping since session 6: replace it
+        damping = f"mass_damping_per_s: {CLOSING_DAMPING_PER_S:g}"
+        if re.search(r"mass_damping_per_s: \S+", text):
+            text = re.sub(r"mass_damping_per_s: \S+", damping, text, count=1)
+        else:
+            text = text.replace("  density: ", f"  {damping}\n  density: ", 1)
     text = re.sub(r"end_time: [0-9.]+", f"end_time: {RUN_END_S:g}", text, count=1)
     text = re.sub(r"snapshot_interval: [0-9.]+", "snapshot_interval: 0.001", text, count=1)
     return text.replace(f'mesh_file: "meshes/{spec.mesh_name}"', f'mesh_file: "{mesh_path}"')
@@ -98,16 +104,20 @@ def main(argv=None) -> None:
     parser.add_argument("--material", default="MHGO", choices=("MHGO", "Ogden"))
     parser.add_argument("--build-dir", type=Path, default=REPO / "build")
     parser.add_argument("--phases", nargs="+", choices=("closing", "opening"), default=["closing", "opening"])
+    parser.add_argument("--commissure-top-row", nargs=2, type=float, metavar=("FACTOR", "COLUMNS"),
+                        help="the sharp corner's top row (valve_mesh.COMMISSURE_TOP_ROW by default; 1 1 = uniform rows)")
     args = parser.parse_args(argv)
+    top_row = None if args.commissure_top_row is None else (args.commissure_top_row[0], int(args.commissure_top_row[1]))
+    tag = "" if top_row is None else f"-top-row-{top_row[0]:g}x{top_row[1]}"
     args.out.mkdir(parents=True, exist_ok=True)
     spec = CaseSpec("FE", args.material, "sector", args.resolution)
     results = {}
     for rho in args.radii:
         params = ValveParameters(commissure_fillet_radius=rho)
-        mesh_path = args.out / f"valve-sector-{args.resolution}-fillet-{rho * 1e3:g}mm.mesh.h5"
-        write_mesh(build_valve_mesh("sector", args.resolution, "triangles", params), mesh_path)
+        mesh_path = args.out / f"valve-sector-{args.resolution}-fillet-{rho * 1e3:g}mm{tag}.mesh.h5"
+        write_mesh(build_valve_mesh("sector", args.resolution, "triangles", params, commissure_top_row=top_row), mesh_path)
         for closing in [phase == "closing" for phase in args.phases]:
-            name = f"{spec.name}-fillet-{rho * 1e3:g}mm-{'closing' if closing else 'opening'}"
+            name = f"{spec.name}-fillet-{rho * 1e3:g}mm{tag}-{'closing' if closing else 'opening'}"
             case_file = args.out / f"{name}.textproto"
             case_file.write_text(check_case(spec, mesh_path, closing))
             wall = run(case_file, args.out / name, args.build_dir)

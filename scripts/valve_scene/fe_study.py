@@ -190,11 +190,13 @@ def analyse_windows(spec: CaseSpec, opening_dir: Path, closing_dir: Path, wall_t
 
 def run_mesh(spec: CaseSpec, run_dir: Path):
     """The run's mesh rebuilt with its node sets: the generator's default, the sharp commissure
-    or the measured 2 mm rounded one, whichever has the run's reference nodes."""
+    (its top row doubled, or uniform rows as before session 12) or the measured 2 mm rounded one,
+    whichever has the run's reference nodes."""
     reference = SolidFields(run_dir).reference_nodes
-    for params in (ValveParameters(), ValveParameters(commissure_fillet_radius=0.0),
-                   ValveParameters(commissure_fillet_radius=2e-3)):
-        mesh = build_valve_mesh(spec.variant, spec.resolution, "triangles", params)
+    for params, top_row in ((ValveParameters(), None), (ValveParameters(commissure_fillet_radius=0.0), None),
+                            (ValveParameters(commissure_fillet_radius=0.0), (1.0, 1)),
+                            (ValveParameters(commissure_fillet_radius=2e-3), None)):
+        mesh = build_valve_mesh(spec.variant, spec.resolution, "triangles", params, commissure_top_row=top_row)
         if mesh.nodes.shape == reference.shape and np.allclose(mesh.nodes, reference, rtol=0, atol=1e-12):
             return mesh
     raise ValueError(f"{run_dir}: its mesh is neither the generator's {spec.variant} {spec.resolution} mesh "

@@ -1,8 +1,8 @@
 """Structured leaflet meshes of the parametric valve: a quad grid per leaflet (columns along
 the circumferential parameter s, rows from the attachment to the free edge, uniform in arc
-length), written as triangles (each quad split) and hexahedra (quads extruded +-t/2 along
-the node normals), with node sets, element sets, material axes and, for the 1/6 sector,
-its symmetry and contact planes.
+length except for a longer top row at a sharp commissure, COMMISSURE_TOP_ROW), written as
+triangles (each quad split) and hexahedra (quads extruded +-t/2 along the node normals), with
+node sets, element sets, material axes and, for the 1/6 sector, its symmetry and contact planes.
 
 The sector is cut out of the full valve's leaflet 0 (columns s >= 0) after the node normals
 were computed on the whole leaflet, so it is exactly the corresponding part of the full mesh.
@@ -21,6 +21,12 @@ from .valve_geometry import (LEAFLET_COUNT, SECTOR_HALF_ANGLE, ValveParameters, 
 # valve has 3 * 48 * 28 * 2 = 8064 triangles (the reference used 7896 bricks).
 RESOLUTIONS = {"coarse": (24, 14), "medium": (48, 28), "fine": (96, 56)}
 VARIANTS = ("full", "sector")
+# The sharp commissure's top row: (factor, columns) of leaflet_grid. The corner element between
+# the tab top and the free edge carries the corner's stress singularity and, under the closed
+# valve's load, set a 0.23 us stable step (MHGO coarse sector, element 335); its height is the
+# tab's row spacing h_tab / nv. Twice that, blended out over two columns, lifts the closed
+# load's smallest step to 0.64 us (docs/valve-scene.md, "The commissure's top row").
+COMMISSURE_TOP_ROW = (2.0, 2)
 ELEMENT_FAMILIES = ("both", "triangles", "hexahedra")
 
 
@@ -41,17 +47,43 @@ class ValveMesh:
     description: dict = field(default_factory=dict)     # provenance attributes
 
 
-def leaflet_grid(p: ValveParameters, cells_circumferential: int, cells_radial: int) -> np.ndarray:
+def row_fractions(nv: int, top_row_factor: float) -> np.ndarray:
+    """Row positions along a column as fractions of its length, [nv + 1]: the top row
+    `top_row_factor` times the uniform spacing 1 / nv, the other rows uniform and shorter."""
+    if not (top_row_factor == 1.0 or 1.0 < top_row_factor < nv):
+        raise ValueError(f"commissure top-row factor {top_row_factor!r}: allowed [1, cells_radial = {nv})")
+    if nv == 1:
+        return np.array([0.0, 1.0])
+    rest = (1.0 - top_row_factor / nv) / (nv - 1)
+    return np.append(np.arange(nv) * rest, 1.0)
+
+
+def leaflet_grid(p: ValveParameters, cells_circumferential: int, cells_radial: int,
+                 commissure_top_row: tuple[float, int] = (1.0, 1)) -> np.ndarray:
     """Nodes of leaflet 0, shape [nu + 1, nv + 1, 3]; rows uniform in arc length per column,
-    then, with a rounded commissure, the corner patches moved onto the trimmed surface."""
+    except near the commissures: `commissure_top_row` = (factor, columns) makes the top row of
+    each tab column `factor` times its uniform spacing, and of the next columns a factor falling
+    linearly to 1 over `columns` columns (the column `columns` away from a tab and the rest are
+    uniform, bit for bit); then, with a rounded commissure, the corner patches moved onto the
+    trimmed surface."""
     nu, nv = cells_circumferential, cells_radial
+    factor, blend_columns = commissure_top_row
+    if blend_columns < 1:
+        raise ValueError(f"commissure top-row blend {blend_columns!r} columns: allowed >= 1")
+    if factor != 1.0 and p.commissure_fillet_radius > 0:
+        raise ValueError(f"commissure top-row factor {factor!r} with a rounded commissure "
+                         f"(commissure_fillet_radius = {p.commissure_fillet_radius!r}): allowed 1 (its patch assumes uniform rows)")
     s = np.linspace(-1.0, 1.0, nu + 1)
     v_dense = np.linspace(0.0, 1.0, 801)
     grid_v = np.empty((nu + 1, nv + 1))
     for i, s_i in enumerate(s):
         dense = leaflet_point(p, s_i, v_dense)
         arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(dense, axis=0), axis=1))])
-        grid_v[i] = np.interp(np.linspace(0.0, arc[-1], nv + 1), arc, v_dense)
+        columns_from_tab = min(i, nu - i)
+        weight = max(0.0, 1.0 - columns_from_tab / blend_columns)
+        targets = (row_fractions(nv, 1.0 + (factor - 1.0) * weight) * arc[-1] if weight > 0 and factor != 1.0
+                   else np.linspace(0.0, arc[-1], nv + 1))
+        grid_v[i] = np.interp(targets, arc, v_dense)
     grid_s = np.repeat(s[:, None], nv + 1, axis=1)
     if p.commissure_fillet_radius > 0:
         # the right half (s >= 0) rounded, the left half its exact mirror image
@@ -247,8 +279,10 @@ def _in_plane_axes(circumferential_hint: np.ndarray, normal: np.ndarray):
 
 def build_valve_mesh(variant: str = "full", resolution: str = "medium", elements: str = "both",
                      params: ValveParameters | None = None,
-                     cells: tuple[int, int] | None = None) -> ValveMesh:
-    """The valve mesh. `cells` = (circumferential per leaflet, even; radial) overrides `resolution`."""
+                     cells: tuple[int, int] | None = None,
+                     commissure_top_row: tuple[float, int] | None = None) -> ValveMesh:
+    """The valve mesh. `cells` = (circumferential per leaflet, even; radial) overrides `resolution`;
+    `commissure_top_row` (factor, columns) overrides COMMISSURE_TOP_ROW (see leaflet_grid)."""
     p = params or ValveParameters()
     p.validate()
     if variant not in VARIANTS:
@@ -263,7 +297,12 @@ def build_valve_mesh(variant: str = "full", resolution: str = "medium", elements
     if nu < 2 or nu % 2 or nv < 1:
         raise ValueError(f"cells {cells}: circumferential count must be even and >= 2, radial >= 1")
 
-    grid0 = leaflet_grid(p, nu, nv)
+    if commissure_top_row is None:
+        # the rounded commissure re-spaces its own corner patch (on uniform rows); grids too short
+        # for the factor stay uniform
+        graded = p.commissure_fillet_radius == 0 and nv > 2 * COMMISSURE_TOP_ROW[0]
+        commissure_top_row = COMMISSURE_TOP_ROW if graded else (1.0, 1)
+    grid0 = leaflet_grid(p, nu, nv, commissure_top_row)
     flips = corner_patch_flips(p, grid0)
     normals0 = _node_normals(grid0, nu, nv, flips)
     columns = range(0, nu + 1) if variant == "full" else range(nu // 2, nu + 1)
@@ -378,6 +417,8 @@ def build_valve_mesh(variant: str = "full", resolution: str = "medium", elements
         "cells_radial": nv,
         "leaflet_count_in_file": len(leaflets),
         "full_valve_fraction": 1.0 if variant == "full" else 1.0 / (2 * LEAFLET_COUNT),
+        "commissure_top_row_factor": float(commissure_top_row[0]),
+        "commissure_top_row_columns": int(commissure_top_row[1]),
         **{f"param_{name}": value for name, value in p.__dict__.items()},
     }
     return mesh

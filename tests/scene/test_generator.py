@@ -12,7 +12,7 @@ import numpy as np
 from valve_scene.mesh_io import read_mesh, write_mesh
 from valve_scene.valve_geometry import (ValveParameters, commissure_fillet, leaflet_point, leaflet_rotation,
                                        leaflet_surface_area)
-from valve_scene.valve_mesh import RESOLUTIONS, build_valve_mesh
+from valve_scene.valve_mesh import COMMISSURE_TOP_ROW, RESOLUTIONS, build_valve_mesh
 
 P = ValveParameters()
 ROUNDED = ValveParameters(commissure_fillet_radius=2e-3)   # the measured fillet (docs/valve-scene.md)
@@ -227,10 +227,12 @@ class RoundedCommissure(unittest.TestCase):
             self.assertLess(angles.max(), largest, resolution)
 
     def test_the_shape_away_from_the_commissure_is_unchanged(self):
+        # against the sharp grid with uniform rows: the fillet re-spaces its own corner patch
+        # and does not take the sharp corner's longer top row
         sharp_params = ValveParameters(commissure_fillet_radius=0.0)
         for resolution in ("coarse", "medium"):
             rounded = build_valve_mesh("full", resolution, "triangles", ROUNDED)
-            sharp = build_valve_mesh("full", resolution, "triangles", sharp_params)
+            sharp = build_valve_mesh("full", resolution, "triangles", sharp_params, commissure_top_row=(1.0, 1))
             tops = np.array([leaflet_rotation(k) @ P.commissure_top(side) for k in range(3) for side in (-1.0, 1.0)])
             distance = np.linalg.norm(sharp.nodes[:, None, :] - tops[None], axis=2).min(axis=1)
             d = commissure_fillet(ROUNDED).tangent_distance
@@ -294,6 +296,78 @@ class RoundedCommissure(unittest.TestCase):
         self.assertIn(ids[0], sharp.node_sets["free_edge"])
         with self.assertRaisesRegex(ValueError, r"commissure_fillet_radius' = 0.005: allowed \[0, 0.002289\]"):
             build_valve_mesh("sector", "coarse", params=ValveParameters(commissure_fillet_radius=5e-3))
+
+
+def smallest_altitudes(nodes, tris):
+    """Each triangle's smallest altitude (twice its area over its longest edge): the length the
+    solid's element bound on the explicit step uses (solid_fe shell_model min_height)."""
+    a, b, c = nodes[tris[:, 0]], nodes[tris[:, 1]], nodes[tris[:, 2]]
+    longest = np.max([np.linalg.norm(b - c, axis=1), np.linalg.norm(c - a, axis=1), np.linalg.norm(a - b, axis=1)], axis=0)
+    return np.linalg.norm(np.cross(b - a, c - a), axis=1) / longest
+
+
+class CommissureTopRow(unittest.TestCase):
+    """The sharp commissure's corner element (tab top, free edge) is twice the tab's row spacing
+    high (valve_mesh.COMMISSURE_TOP_ROW): with uniform rows it was one spacing high and set the
+    closed valve's 0.23 us step (docs/valve-scene.md, "The commissure's top row")."""
+
+    @staticmethod
+    def corner_triangles(mesh):
+        tops = np.array([leaflet_rotation(k) @ P.commissure_top(side) for k in range(3) for side in (-1.0, 1.0)])
+        distance = np.linalg.norm(mesh.nodes[:, None, :] - tops[None], axis=2).min(axis=1)
+        corners = np.flatnonzero(distance < 1e-12)
+        return np.flatnonzero(np.isin(mesh.triangles, corners).any(axis=1))
+
+    def test_the_corner_element_is_not_the_tabs_row_spacing_high(self):
+        # smallest altitude of the triangles at a commissure top over the tab's uniform row
+        # spacing h_tab / nv: 0.961 with uniform rows (coarse 0.343 mm, medium 0.172 mm), 1.664
+        # with the top row twice as long (0.594, 0.297 mm); the element bound on the step
+        # scales with it at a given stiffness
+        self.assertEqual(COMMISSURE_TOP_ROW, (2.0, 2))
+        for resolution in ("coarse", "medium", "fine"):
+            nv = RESOLUTIONS[resolution][1]
+            for variant in ("full", "sector"):
+                mesh = build_valve_mesh(variant, resolution, "triangles")
+                corner = self.corner_triangles(mesh)
+                self.assertEqual(len(corner), 6 if variant == "full" else 1)
+                ratio = smallest_altitudes(mesh.nodes, mesh.triangles[corner]).min() / (P.tab_height / nv)
+                self.assertAlmostEqual(ratio, 1.664, delta=0.005, msg=f"{variant} {resolution}")
+            uniform = build_valve_mesh("sector", resolution, "triangles", commissure_top_row=(1.0, 1))
+            corner = self.corner_triangles(uniform)
+            self.assertLess(smallest_altitudes(uniform.nodes, uniform.triangles[corner]).min() / (P.tab_height / nv), 0.97)
+
+    def test_the_top_row_doubles_on_the_tab_and_the_rest_is_unchanged(self):
+        for resolution in ("coarse", "medium"):
+            nu, nv = RESOLUTIONS[resolution]
+            graded = build_valve_mesh("full", resolution, "triangles")
+            uniform = build_valve_mesh("full", resolution, "triangles", commissure_top_row=(1.0, 1))
+            self.assertEqual(graded.triangles.tolist(), uniform.triangles.tolist())
+            for name, ids in uniform.node_sets.items():
+                np.testing.assert_array_equal(graded.node_sets[name], ids, name)
+            # leaflet 0's grid: column i of nv + 1 nodes; the tab columns and their neighbours move
+            grid = graded.nodes[:(nu + 1) * (nv + 1)].reshape(nu + 1, nv + 1, 3)
+            before = uniform.nodes[:(nu + 1) * (nv + 1)].reshape(nu + 1, nv + 1, 3)
+            np.testing.assert_array_equal(grid[2:nu - 1], before[2:nu - 1])
+            self.assertTrue(np.all(np.abs(grid[[0, 1, nu - 1, nu], 1:nv] - before[[0, 1, nu - 1, nu], 1:nv]).max(axis=-1) > 0))
+            np.testing.assert_array_equal(grid[:, [0, nv]], before[:, [0, nv]])   # attachment and free edge rows
+            tab = grid[nu, :, 2]                                                     # the tab: vertical, on the stent
+            rows = np.diff(tab)
+            # (rows are placed by arc length on a dense sampling of each column: ~1 nm)
+            np.testing.assert_allclose(rows[-1], 2.0 * P.tab_height / nv, atol=1e-8)
+            np.testing.assert_allclose(rows[:-1], (P.tab_height - 2.0 * P.tab_height / nv) / (nv - 1), atol=1e-8)
+            # the price: the tab's other rows are (nv - 2) / (nv - 1) as long, so the mesh's smallest
+            # altitude (at the tab's foot) falls by at most that much (coarse 0.229 -> 0.220 mm)
+            self.assertGreater(smallest_altitudes(graded.nodes, graded.triangles).min(),
+                               (nv - 2) / (nv - 1) * smallest_altitudes(uniform.nodes, uniform.triangles).min())
+
+    def test_a_rounded_commissure_keeps_uniform_rows_and_a_bad_factor_is_named(self):
+        sector = build_valve_mesh("sector", "coarse", "triangles", ROUNDED)
+        self.assertEqual(sector.description["commissure_top_row_factor"], 1.0)
+        self.assertEqual(build_valve_mesh("sector", "coarse", "triangles").description["commissure_top_row_factor"], 2.0)
+        with self.assertRaisesRegex(ValueError, r"commissure top-row factor 14.0: allowed \[1, cells_radial = 14\)"):
+            build_valve_mesh("sector", "coarse", commissure_top_row=(14.0, 2))
+        with self.assertRaisesRegex(ValueError, "commissure top-row factor 2.0 with a rounded commissure"):
+            build_valve_mesh("sector", "coarse", "triangles", ROUNDED, commissure_top_row=(2.0, 2))
 
 
 class MeshFile(unittest.TestCase):

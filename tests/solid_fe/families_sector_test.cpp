@@ -1,6 +1,6 @@
 // The coarse 1/6 valve sector opening FE-only under the default case's pressure, run by
 // `solid_fe` once with shell triangles and once with one layer of bricks (meshes from the scene
-// generator): the free-edge midpoint's opening (10-90 % time, largest radius, radius at 12 ms)
+// generator): the free-edge midpoint's opening (10-90 % time, largest radius, mean radius over 6-12 ms)
 // must agree within the bands below. Validation: it takes ~15 s of CPU and the Python generator.
 #include <hdf5.h>
 
@@ -41,7 +41,7 @@ int shell(const std::string& command) {
 }
 
 struct Opening {
-  double t10 = 0, t90 = 0, largest_radius = 0, final_radius = 0;
+  double t10 = 0, t90 = 0, largest_radius = 0, final_radius = 0, open_mean_radius = 0;
 };
 
 Opening run(const std::filesystem::path& dir, const std::string& family) {
@@ -67,6 +67,17 @@ Opening run(const std::filesystem::path& dir, const std::string& family) {
   if (r.empty() || r.size() != t.size()) return o;
   o.largest_radius = *std::max_element(r.begin(), r.end());
   o.final_radius = r.back();
+  // The open leaflet flutters (8.6-11.6 mm over 6-12 ms), so one instant measures its phase; the
+  // mean over the open phase measures where it stands.
+  double sum = 0;
+  int count = 0;
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    if (t[k] >= 6e-3) {
+      sum += r[k];
+      ++count;
+    }
+  }
+  o.open_mean_radius = count > 0 ? sum / count : 0.0;
   const auto crossing = [&](double fraction) {
     const double level = r.front() + fraction * (o.largest_radius - r.front());
     for (std::size_t k = 0; k < r.size(); ++k) {
@@ -87,6 +98,7 @@ TEST(SolidFamilies, SectorOpensAlikeWithShellsAndBricks) {
   std::printf("sector opening, shell vs bricks: 10 %% at %.2f / %.2f ms, 90 %% at %.2f / %.2f ms, largest free-edge "
               "radius %.3f / %.3f mm, at 12 ms %.3f / %.3f mm\n", s.t10 * 1e3, b.t10 * 1e3, s.t90 * 1e3, b.t90 * 1e3,
               s.largest_radius * 1e3, b.largest_radius * 1e3, s.final_radius * 1e3, b.final_radius * 1e3);
+  std::printf("mean free-edge radius over 6-12 ms %.3f / %.3f mm\n", s.open_mean_radius * 1e3, b.open_mean_radius * 1e3);
   ASSERT_GT(s.largest_radius, 0.009);  // both open to the stent
   ASSERT_GT(b.largest_radius, 0.009);
   // Bands: opening times within 0.5 ms; radii within 0.3 mm (the brick node monitored lies on the
@@ -94,7 +106,10 @@ TEST(SolidFamilies, SectorOpensAlikeWithShellsAndBricks) {
   EXPECT_NEAR(b.t10, s.t10, 0.5e-3);
   EXPECT_NEAR(b.t90, s.t90, 0.5e-3);
   EXPECT_NEAR(b.largest_radius, s.largest_radius, 0.3e-3);
-  EXPECT_NEAR(b.final_radius, s.final_radius, 0.3e-3);
+  // Over the open phase's mean, not at 12 ms: the sample at one instant of the +-1.5 mm flutter
+  // differed by 0.08 mm (uniform rows) and 0.61 mm (the commissure's top row doubled, session 12)
+  // while the means differed by 0.27 and 0.05 mm.
+  EXPECT_NEAR(b.open_mean_radius, s.open_mean_radius, 0.3e-3);
 }
 
 }  // namespace

@@ -267,6 +267,7 @@ void ExplicitSolver::compute_contact_force() {
     }
   }
   if (leaflet_contact_) {
+    if (implicit_) own_contact_force_ = f;  // the tangent's per-node springs (implicit_dynamics.cpp)
     state_.nodes_in_contact +=
         leaflet_contact_->add_forces(*elements_->contact_surface(), x, options_.contact_stiffness_factor * omega2, f,
                                      state_.contact_candidates);

@@ -325,6 +325,7 @@ class ExplicitSolver {
   double step_factor_ = 0.0;     // > 0: tests' override of the safety factor
   std::function<void(const SolverState&)> step_observer_;
   Eigen::VectorXd half_thickness_;  // per node: contact offset of the surface
+  Eigen::Matrix3Xd own_contact_force_;  // implicit with leaflet contact: the planes' and stent's part
   Eigen::Matrix3Xd acceleration_;
   Eigen::Matrix3Xd previous_half_velocity_;  // for the damping work
   Eigen::Matrix3Xd probe_position_, probe_force_, probe_vector_;  // calibration work arrays

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "valvefsi/solid/element_model.hpp"
 #include "valvefsi/solid/shell_model.hpp"
 
 namespace valvefsi::solid {
@@ -55,6 +56,11 @@ class LeafletContact {
   // potential whose gradient add_forces applies (for the ledger's check).
   double penalty_energy(const ShellModel& model, const Eigen::Matrix3Xd& x, double stiffness_per_mass,
                         const ContactCandidates& candidates) const;
+  // Tangent of the penalty forces at x over the current candidates, -d(force)/dx (a stiffness,
+  // as ElementModel's internal-force tangent): per pair in contact the 4 x 4 blocks coupling the
+  // node and the triangle's three nodes, with the gap's geometry (closest point, normal).
+  void add_tangent(const ShellModel& model, const Eigen::Matrix3Xd& x, double stiffness_per_mass,
+                   const ContactCandidates& candidates, std::vector<NodeBlock>& blocks) const;
 
  private:
   void rebuild(const ShellModel& model, const Eigen::Matrix3Xd& x, ContactCandidates& candidates) const;
@@ -63,6 +69,10 @@ class LeafletContact {
   // point's barycentric weights; returns the gap (>= 0: apart).
   double gap(const ShellModel& model, const Eigen::Matrix3Xd& x, std::int32_t i, std::int32_t e,
              Eigen::Vector3d& direction, Eigen::Vector3d& weights) const;
+  // The same for a node at p and a triangle (a, b, c).
+  static double pair_gap(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                         const Eigen::Vector3d& c, double node_half_thickness, double triangle_thickness,
+                         Eigen::Vector3d& direction, Eigen::Vector3d& weights);
 
   std::vector<int> surface_of_node_;
   bool self_contact_ = false;

@@ -57,34 +57,37 @@ bool may_meet(const std::array<Vec3, 2>& box, double sp, double sq, const Vec3& 
   return true;
 }
 
+// Signed distance of x from triangle t's plane (the cheap rejection's input; the one
+// expression for it, so that a cached value is the value recomputed).
+double plane_side(const std::vector<Vec3>& normal, const std::vector<double>& offset, std::uint32_t t, const Vec3& x) {
+  return dot(normal[t], x) - offset[t];
+}
+
 // Whether the segment p -> q meets any of the triangles (touching counts).
 bool crosses_any(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles, const std::vector<Vec3>& normal,
                  const std::vector<double>& offset, const std::vector<std::array<Vec3, 2>>& boxes, const Vec3& p,
                  const Vec3& q) {
-  thread_local std::vector<std::uint32_t> one(1);
   for (const std::uint32_t t : triangles) {
-    const double sp = dot(normal[t], p) - offset[t], sq = dot(normal[t], q) - offset[t];
+    const double sp = plane_side(normal, offset, t, p), sq = plane_side(normal, offset, t, q);
     if (!may_meet(boxes[t], sp, sq, p, q)) continue;
-    one[0] = t;
-    if (first_crossing(mesh, one, p, q)) return true;
+    if (crossing(mesh, t, p, q)) return true;
   }
   return false;
 }
 
 // The same over candidates sorted by their distance from p (`distances`, one per triangle, or
 // none: then all are tested): a triangle the segment meets lies within `reach` of p, so the scan
-// stops at the first farther one. Exact, the answer is that of crosses_any.
+// stops at the first farther one. `p_sides`: p's plane_side per candidate when cached at the
+// classify (or null). Exact, the answer is that of crosses_any.
 bool crosses_any_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles, const std::vector<double>* distances,
-                        double reach, const std::vector<Vec3>& normal, const std::vector<double>& offset,
+                        const double* p_sides, double reach, const std::vector<Vec3>& normal, const std::vector<double>& offset,
                         const std::vector<std::array<Vec3, 2>>& boxes, const Vec3& p, const Vec3& q) {
   if (distances == nullptr || distances->size() != triangles.size()) return crosses_any(mesh, triangles, normal, offset, boxes, p, q);
-  thread_local std::vector<std::uint32_t> one(1);
   for (std::size_t k = 0; k < triangles.size() && (*distances)[k] <= reach; ++k) {
     const std::uint32_t t = triangles[k];
-    const double sp = dot(normal[t], p) - offset[t], sq = dot(normal[t], q) - offset[t];
+    const double sp = p_sides != nullptr ? p_sides[k] : plane_side(normal, offset, t, p), sq = plane_side(normal, offset, t, q);
     if (!may_meet(boxes[t], sp, sq, p, q)) continue;
-    one[0] = t;
-    if (first_crossing(mesh, one, p, q)) return true;
+    if (crossing(mesh, t, p, q)) return true;
   }
   return false;
 }
@@ -439,7 +442,10 @@ void ThinWallModel3D::classify(const Particles<3>& p) {
   if (s.side_by_id.size() <= max_id) s.side_by_id.resize(max_id + 1, 0);
   if (s.corrected_by_id.size() <= max_id) s.corrected_by_id.resize(max_id + 1, 0);
   const double R = fluid_.support_radius();
+  s.candidate_side.resize(n);
+  s.classified_position.resize(n);
   buckets_.build(face_box_, R);
+  buckets_.cache_neighbourhoods();  // one gather and sort per cell, not per particle
   Vec3 lo = mesh_.position[0], hi = mesh_.position[0];
   for (const auto& x : mesh_.position)
     for (int d = 0; d < 3; ++d) {
@@ -456,16 +462,22 @@ void ThinWallModel3D::classify(const Particles<3>& p) {
       const auto i = static_cast<std::size_t>(ii);
       auto& cand = s.candidates[i];
       auto& cand_distance = s.candidate_distance[i];
+      auto& cand_side = s.candidate_side[i];
       cand.clear();
       cand_distance.clear();
+      cand_side.clear();
+      const Vec3 x = position_of(p, i);
+      s.classified_position[i] = x;
       if (p.kind[i] == Kind::lost) continue;
       const std::uint32_t id = p.id[i];
-      const Vec3 x = position_of(p, i);
       bool outside = false;
       for (int d = 0; d < 3; ++d) outside = outside || x[d] < lo[d] || x[d] > hi[d];
       if (!outside) {
-        buckets_.query({x[0] - R, x[1] - R, x[2] - R}, {x[0] + R, x[1] + R, x[2] + R}, boxed);
-        triangles_within(mesh_, boxed, x, R, cand, cand_distance);
+        // A superset of the buckets' answer for the support round x: the same triangles within R.
+        const auto around = buckets_.around({x[0] - R, x[1] - R, x[2] - R}, {x[0] + R, x[1] + R, x[2] + R}, boxed);
+        triangles_within(mesh_, face_box_, around, x, R, cand, cand_distance);
+        cand_side.resize(cand.size());
+        for (std::size_t k = 0; k < cand.size(); ++k) cand_side[k] = plane_side(face_normal_, face_offset_, cand[k], x);
       }
       if (cand.empty()) {
         if (p.kind[i] == Kind::fluid) s.side_by_id[id] = 0;
@@ -502,7 +514,8 @@ bool ThinWallModel3D::blocked(std::uint32_t a, std::uint32_t b, const Particles<
   // A triangle met at m is within |am| of a while b is at least its distance d_b from the mesh
   // away from m: only a's candidates within |ab| - d_b can be met (the margin covers rounding).
   const double reach = ab - near[b].closest.distance + reach_margin();
-  return crosses_any_within(mesh_, dyn_.candidates[a], distances_of(a), reach, face_normal_, face_offset_, face_box_, xa, xb);
+  return crosses_any_within(mesh_, dyn_.candidates[a], distances_of(a), sides_of(a, xa), reach, face_normal_, face_offset_, face_box_, xa,
+                            xb);
 }
 
 void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGrid<3>& grid) {
@@ -536,7 +549,8 @@ void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGri
           const Vec3 target{xm[0] + side * tiny * nm[0], xm[1] + side * tiny * nm[1], xm[2] + side * tiny * nm[2]};
           const bool shifted = seg.shift[0] != 0 || seg.shift[1] != 0 || seg.shift[2] != 0;  // candidates are b's own
           const double reach = shifted ? std::numeric_limits<double>::infinity() : norm(sub(target, xb)) + reach_margin();
-          if (crosses_any_within(mesh_, s.candidates[b], distances_of(b), reach, face_normal_, face_offset_, face_box_, xb, target))
+          if (crosses_any_within(mesh_, s.candidates[b], distances_of(b), sides_of(b, xb), reach, face_normal_, face_offset_, face_box_, xb,
+                                 target))
             continue;
           const double w = W.value(static_cast<float>(dist));
           const int k = side_index(side);
@@ -790,7 +804,7 @@ bool ThinWallModel3D::accept_shift(const Particles<3>& p, std::size_t i, const V
   const Vec3 x = position_of(p, i);
   const Vec3 y{x[0] + shift[0], x[1] + shift[1], x[2] + shift[2]};
   const double reach = std::sqrt(shift[0] * shift[0] + shift[1] * shift[1] + shift[2] * shift[2]) + reach_margin();
-  bool ok = !crosses_any_within(mesh_, s.candidates[i], distances_of(i), reach, face_normal_, face_offset_, face_box_, x, y);
+  bool ok = !crosses_any_within(mesh_, s.candidates[i], distances_of(i), sides_of(i, x), reach, face_normal_, face_offset_, face_box_, x, y);
   if (ok) {
     const double after = closest_point(mesh_, s.candidates[i], y).distance;
     ok = !(after < clearance_ && after < s.near[i].closest.distance);
@@ -907,6 +921,8 @@ void ThinWallModel3D::load_restart_state(std::span<const NamedArray> arrays) {
   }
   s.candidates = in.lists("particles.candidates", near.size());
   s.candidate_distance.clear();  // not stored: the next classify rebuilds them (until then every candidate is tested)
+  s.candidate_side.clear();
+  s.classified_position.clear();
   for (const auto& list : s.candidates)
     for (const auto t : list)
       if (t >= mesh_.triangles.size())

@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -90,6 +91,60 @@ bool crosses_any_within(const TriangleMesh& mesh, const std::vector<std::uint32_
     if (crossing(mesh, t, p, q)) return true;
   }
   return false;
+}
+
+// One particle's candidates scattered by triangle (distance and plane side; distance +inf for
+// the other triangles), per thread: the other end of a pair looks its triangles up in it.
+struct ScatteredCandidates {
+  const void* model = nullptr;
+  std::uint64_t generation = 0;
+  std::uint32_t particle = std::numeric_limits<std::uint32_t>::max();
+  std::vector<double> distance, side;
+  std::vector<std::uint32_t> triangles;  // the ones set, to reset
+
+  bool holds(const void* m, std::uint64_t g, std::uint32_t i) const { return model == m && generation == g && particle == i; }
+  void fill(const void* m, std::uint64_t g, std::uint32_t i, std::size_t mesh_triangles, const std::vector<std::uint32_t>& cand,
+            const std::vector<double>& cand_distance, const double* cand_side) {
+    if (model != m || distance.size() != mesh_triangles) {
+      distance.assign(mesh_triangles, std::numeric_limits<double>::infinity());
+      side.assign(mesh_triangles, 0.0);
+    } else {
+      for (const std::uint32_t t : triangles) distance[t] = std::numeric_limits<double>::infinity();
+    }
+    for (std::size_t k = 0; k < cand.size(); ++k) {
+      distance[cand[k]] = cand_distance[k];
+      side[cand[k]] = cand_side[k];
+    }
+    triangles = cand;
+    model = m;
+    generation = g;
+    particle = i;
+  }
+};
+
+// Whether the segment p -> q meets a triangle near both ends: the candidates of one end (`list`,
+// distances ascending, its plane sides; it is p when list_is_p) up to list_reach, each looked up
+// in the other end's scatter and kept only within other_reach of it and with the two distances'
+// sum within `bound` (a triangle met at m is within |pm| of p and |mq| of q). The same plane test
+// and exact test on the same values as crosses_any_within decide those kept.
+bool crosses_common(const TriangleMesh& mesh, const std::vector<std::array<Vec3, 2>>& boxes, const std::vector<std::uint32_t>& list,
+                    const std::vector<double>& dist, const double* sides, double list_reach, bool list_is_p,
+                    const ScatteredCandidates& other, double other_reach, double bound, const Vec3& p, const Vec3& q) {
+  for (std::size_t k = 0; k < list.size() && dist[k] <= list_reach; ++k) {
+    const std::uint32_t t = list[k];
+    const double d = other.distance[t];
+    if (d > other_reach || dist[k] + d > bound) continue;
+    const double sp = list_is_p ? sides[k] : other.side[t], sq = list_is_p ? other.side[t] : sides[k];
+    if (!may_meet(boxes[t], sp, sq, p, q)) continue;
+    if (crossing(mesh, t, p, q)) return true;
+  }
+  return false;
+}
+
+// Fresh for every classify (of any model): tells the per-thread caches that they are stale.
+std::uint64_t next_generation() {
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
 }
 
 // Length of the shortest path from a to b through a point of the segment [p, q]. The sum of the
@@ -330,6 +385,7 @@ void ThinWallModel3D::place_mesh() {
     mesh_acceleration_[k] = to_image(map, dyn_.a[j]);
   }
   mesh_.update();
+  buckets_current_ = false;  // until the next classify
   face_normal_.resize(mesh_.triangles.size());
   face_offset_.resize(mesh_.triangles.size());
   face_box_ = triangle_boxes(mesh_);
@@ -446,6 +502,8 @@ void ThinWallModel3D::classify(const Particles<3>& p) {
   s.classified_position.resize(n);
   buckets_.build(face_box_, R);
   buckets_.cache_neighbourhoods();  // one gather and sort per cell, not per particle
+  buckets_current_ = true;
+  generation_ = next_generation();
   Vec3 lo = mesh_.position[0], hi = mesh_.position[0];
   for (const auto& x : mesh_.position)
     for (int d = 0; d < 3; ++d) {
@@ -456,7 +514,7 @@ void ThinWallModel3D::classify(const Particles<3>& p) {
   const auto count = static_cast<std::ptrdiff_t>(n);
 #pragma omp parallel reduction(+ : leaks)
   {
-    std::vector<std::uint32_t> boxed;
+    std::vector<std::uint32_t> boxed, nearest(1);
 #pragma omp for schedule(dynamic, 256)
     for (std::ptrdiff_t ii = 0; ii < count; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
@@ -484,7 +542,10 @@ void ThinWallModel3D::classify(const Particles<3>& p) {
         continue;
       }
       NearWall& nw = s.near[i];
-      nw.closest = closest_point(mesh_, cand, x);
+      // The candidates come nearest first, by the distance closest_point computes (ties by
+      // index): the first is its answer, without the other candidates' distances again.
+      nearest[0] = cand[0];
+      nw.closest = closest_point(mesh_, nearest, x);
       nw.near = true;
       if (p.kind[i] != Kind::fluid) continue;
       // A particle may change side only round a free edge or through a put-back; otherwise
@@ -514,8 +575,40 @@ bool ThinWallModel3D::blocked(std::uint32_t a, std::uint32_t b, const Particles<
   // A triangle met at m is within |am| of a while b is at least its distance d_b from the mesh
   // away from m: only a's candidates within |ab| - d_b can be met (the margin covers rounding).
   const double reach = ab - near[b].closest.distance + reach_margin();
-  return crosses_any_within(mesh_, dyn_.candidates[a], distances_of(a), sides_of(a, xa), reach, face_normal_, face_offset_, face_box_, xa,
-                            xb);
+  const double* sides_a = sides_of(a, xa);
+  const double* sides_b = sides_of(b, xb);
+  if (sides_a == nullptr || sides_b == nullptr || distances_of(a) == nullptr || distances_of(b) == nullptr || !(ab < R - reach_margin()))
+    return crosses_any_within(mesh_, dyn_.candidates[a], distances_of(a), sides_a, reach, face_normal_, face_offset_, face_box_, xa, xb);
+  // Closer still: a triangle met at m is within |am| of a and |mb| of b, so (|ab| < R) it is a
+  // candidate of both with d_a + d_b <= |ab|, a thin ellipsoid round the segment. With one
+  // end's candidates scattered by triangle, the other end's list drops the rest by a look-up.
+  // The same plane test and exact test on the same values decide the few left: the answer of
+  // crosses_any_within (these triangles are a subset of its own, the rest cannot be met).
+  const double bound = ab + 2.0 * reach_margin();
+  thread_local std::array<ScatteredCandidates, 2> slots;
+  thread_local std::uint32_t last_b = std::numeric_limits<std::uint32_t>::max();
+  thread_local int next_slot = 0;
+  const ScatteredCandidates* of_a = nullptr;
+  const ScatteredCandidates* of_b = nullptr;
+  for (const auto& slot : slots) {
+    if (slot.holds(this, generation_, a)) of_a = &slot;
+    if (slot.holds(this, generation_, b)) of_b = &slot;
+  }
+  if (of_a == nullptr && of_b == nullptr) {
+    // Scatter the end that repeats: b when the caller sweeps many a against one b, else a.
+    const std::uint32_t i = b == last_b ? b : a;
+    ScatteredCandidates& slot = slots[static_cast<std::size_t>(next_slot)];
+    next_slot = 1 - next_slot;
+    slot.fill(this, generation_, i, mesh_.triangles.size(), dyn_.candidates[i], dyn_.candidate_distance[i], i == a ? sides_a : sides_b);
+    (i == a ? of_a : of_b) = &slot;
+  }
+  last_b = b;
+  const double inf = std::numeric_limits<double>::infinity();
+  if (of_a != nullptr)  // b's list (within bound - d_a of b, as d_a <= D_a), a's look-ups
+    return crosses_common(mesh_, face_box_, dyn_.candidates[b], dyn_.candidate_distance[b], sides_b, bound - near[a].closest.distance,
+                          false, *of_a, reach, bound, xa, xb);
+  return crosses_common(mesh_, face_box_, dyn_.candidates[a], dyn_.candidate_distance[a], sides_a, reach, true, *of_b, inf, bound, xa,
+                        xb);
 }
 
 void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGrid<3>& grid) {
@@ -533,6 +626,12 @@ void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGri
       const double nl = norm(nm);
       nm = {nm[0] / nl, nm[1] / nl, nm[2] / nl};
       const Vec3 am = settings_.wall_acceleration_in_pressure ? dyn_.a[j] : Vec3{0, 0, 0};
+      // The triangles near the node seen from each side, scattered once for all its particles
+      // (as the blocking's per-particle scatter: a triangle between b and the node is near both).
+      thread_local std::array<ScatteredCandidates, 2> seen_from;
+      thread_local std::vector<std::uint32_t> near_node, boxed;
+      thread_local std::vector<double> near_node_distance, near_node_side;
+      std::array<bool, 2> scattered{false, false};
       std::array<NeighbourSegment<3>, 27> segments;
       const int segment_count = grid.neighbour_segments(cell_of_point(grid, xm), segments);
       double sw[2] = {0, 0}, sp[2] = {0, 0}, srr[2][3] = {}, sv[2][3] = {};
@@ -548,10 +647,28 @@ void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGri
           // The node as seen from b's side: nothing of the mesh may lie in between.
           const Vec3 target{xm[0] + side * tiny * nm[0], xm[1] + side * tiny * nm[1], xm[2] + side * tiny * nm[2]};
           const bool shifted = seg.shift[0] != 0 || seg.shift[1] != 0 || seg.shift[2] != 0;  // candidates are b's own
-          const double reach = shifted ? std::numeric_limits<double>::infinity() : norm(sub(target, xb)) + reach_margin();
-          if (crosses_any_within(mesh_, s.candidates[b], distances_of(b), sides_of(b, xb), reach, face_normal_, face_offset_, face_box_, xb,
-                                 target))
+          const double to_target = norm(sub(target, xb));
+          const double reach = shifted ? std::numeric_limits<double>::infinity() : to_target + reach_margin();
+          const double* sides_b = shifted ? nullptr : sides_of(b, xb);
+          const int k_seen = side_index(side);
+          if (sides_b != nullptr && distances_of(b) != nullptr && buckets_current_ && to_target < R - reach_margin()) {
+            ScatteredCandidates& seen = seen_from[static_cast<std::size_t>(k_seen)];
+            if (!scattered[static_cast<std::size_t>(k_seen)]) {
+              const auto around = buckets_.around({target[0] - R, target[1] - R, target[2] - R}, {target[0] + R, target[1] + R, target[2] + R},
+                                                  boxed);
+              triangles_within(mesh_, face_box_, around, target, R, near_node, near_node_distance);
+              near_node_side.resize(near_node.size());
+              for (std::size_t k = 0; k < near_node.size(); ++k) near_node_side[k] = plane_side(face_normal_, face_offset_, near_node[k], target);
+              seen.fill(this, 0, static_cast<std::uint32_t>(j), mesh_.triangles.size(), near_node, near_node_distance, near_node_side.data());
+              scattered[static_cast<std::size_t>(k_seen)] = true;
+            }
+            if (crosses_common(mesh_, face_box_, s.candidates[b], s.candidate_distance[b], sides_b, reach, true, seen,
+                               std::numeric_limits<double>::infinity(), to_target + 2.0 * reach_margin(), xb, target))
+              continue;
+          } else if (crosses_any_within(mesh_, s.candidates[b], distances_of(b), sides_of(b, xb), reach, face_normal_, face_offset_, face_box_,
+                                        xb, target)) {
             continue;
+          }
           const double w = W.value(static_cast<float>(dist));
           const int k = side_index(side);
           const double rho_b = fluid_.rest_density + p.density_excess[b];
@@ -844,6 +961,7 @@ void ThinWallModel3D::save_checkpoint() { checkpoint_ = dyn_; }
 void ThinWallModel3D::restore_checkpoint() {
   if (!checkpoint_) throw std::logic_error("thin wall 3D restore_checkpoint: no checkpoint was saved");
   dyn_ = *checkpoint_;
+  generation_ = next_generation();
   place_mesh();
 }
 
@@ -941,6 +1059,7 @@ void ThinWallModel3D::load_restart_state(std::span<const NamedArray> arrays) {
   const auto counters = in.scalars<std::size_t>("counters", 3);
   s.counters = {counters[0], counters[1], counters[2]};
   dyn_ = std::move(s);
+  generation_ = next_generation();
   place_mesh();
 }
 

@@ -194,6 +194,8 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
   std::vector<double> face_offset_;  // normal . first corner
   std::vector<std::array<Vec3, 2>> face_box_;  // bounding box per mesh triangle
   TriangleBuckets buckets_;
+  bool buckets_current_ = false;  // built for the mesh as it is placed now
+  std::uint64_t generation_ = 0;  // of the per-particle data (new at each classify or restore): keys the blocking's per-thread caches
   NodeLoadSmoother smoother_;
   Dynamic dyn_;
   std::optional<Dynamic> checkpoint_;

@@ -810,8 +810,20 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
         for (int l = first_layer; l <= layers; ++l) {
           const double depth = first_depth + (l - 1) * delta;
           if (depth <= -nl) continue;  // not beyond the particle's own position
-          for (int i = -layers; i <= layers; ++i)
-            for (int j = -layers; j <= layers; ++j) {
+          // x_a - x_v = (nl + depth) n - i delta t1 - j delta t2 (n, t1, t2 orthonormal), so only
+          // |i|, |j| within the layer's disc can pass the r2 test below: the rest are skipped
+          // before computing them. The bound is widened by 1e-6 of R^2, far above the rounding
+          // of r2 and the particle's offset from the axis when nl ~ 0 (1e-9 dp): the points
+          // tested, and their order, are those that passed before.
+          const double along = nl + depth;
+          const double room = R * R * (1.0 + 1e-6) - along * along;
+          if (room < 0.0) continue;
+          const int span_i = std::min(layers, static_cast<int>(std::sqrt(room) / delta));
+          for (int i = -span_i; i <= span_i; ++i) {
+            const double room_i = room - (i * delta) * (i * delta);
+            if (room_i < 0.0) continue;
+            const int span_j = std::min(layers, static_cast<int>(std::sqrt(room_i) / delta));
+            for (int j = -span_j; j <= span_j; ++j) {
               Vec3 xv;
               for (int d = 0; d < 3; ++d) xv[d] = c.point[d] + i * delta * t1[d] + j * delta * t2[d] - depth * n[d];
               const Vec3 r = sub(xa, xv);
@@ -900,6 +912,7 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
                 for (int d = 0; d < 3; ++d) f[d] += w * load[d];
               }
             }
+          }
         }
         }
         for (int d = 0; d < 3; ++d) p.acceleration[d][a] += static_cast<float>(acc[d]);

@@ -655,19 +655,21 @@ void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGri
           if (sides_b != nullptr && distances_of(b) != nullptr && buckets_current_ && to_target < R - reach_margin()) {
             ScatteredCandidates& seen = seen_from[static_cast<std::size_t>(k_seen)];
             if (!scattered[static_cast<std::size_t>(k_seen)]) {
-              const auto around = buckets_.around({target[0] - R, target[1] - R, target[2] - R}, {target[0] + R, target[1] + R, target[2] + R},
-                                                  boxed);
+              const Vec3 lower{target[0] - R, target[1] - R, target[2] - R}, upper{target[0] + R, target[1] + R, target[2] + R};
+              const auto around = buckets_.around(lower, upper, boxed);
               triangles_within(mesh_, face_box_, around, target, R, near_node, near_node_distance);
               near_node_side.resize(near_node.size());
-              for (std::size_t k = 0; k < near_node.size(); ++k) near_node_side[k] = plane_side(face_normal_, face_offset_, near_node[k], target);
-              seen.fill(this, 0, static_cast<std::uint32_t>(j), mesh_.triangles.size(), near_node, near_node_distance, near_node_side.data());
+              for (std::size_t k = 0; k < near_node.size(); ++k)
+                near_node_side[k] = plane_side(face_normal_, face_offset_, near_node[k], target);
+              seen.fill(this, 0, static_cast<std::uint32_t>(j), mesh_.triangles.size(), near_node, near_node_distance,
+                        near_node_side.data());
               scattered[static_cast<std::size_t>(k_seen)] = true;
             }
             if (crosses_common(mesh_, face_box_, s.candidates[b], s.candidate_distance[b], sides_b, reach, true, seen,
                                std::numeric_limits<double>::infinity(), to_target + 2.0 * reach_margin(), xb, target))
               continue;
-          } else if (crosses_any_within(mesh_, s.candidates[b], distances_of(b), sides_of(b, xb), reach, face_normal_, face_offset_, face_box_,
-                                        xb, target)) {
+          } else if (crosses_any_within(mesh_, s.candidates[b], distances_of(b), sides_of(b, xb), reach, face_normal_, face_offset_,
+                                        face_box_, xb, target)) {
             continue;
           }
           const double w = W.value(static_cast<float>(dist));
@@ -936,7 +938,8 @@ bool ThinWallModel3D::accept_shift(const Particles<3>& p, std::size_t i, const V
   const Vec3 x = position_of(p, i);
   const Vec3 y{x[0] + shift[0], x[1] + shift[1], x[2] + shift[2]};
   const double reach = std::sqrt(shift[0] * shift[0] + shift[1] * shift[1] + shift[2] * shift[2]) + reach_margin();
-  bool ok = !crosses_any_within(mesh_, s.candidates[i], distances_of(i), sides_of(i, x), reach, face_normal_, face_offset_, face_box_, x, y);
+  bool ok =
+      !crosses_any_within(mesh_, s.candidates[i], distances_of(i), sides_of(i, x), reach, face_normal_, face_offset_, face_box_, x, y);
   if (ok) {
     const double after = closest_point(mesh_, s.candidates[i], y).distance;
     ok = !(after < clearance_ && after < s.near[i].closest.distance);

@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -43,8 +44,9 @@ std::size_t cell_of_point(const CellGrid<3>& grid, const Vec3& x) {
 }
 
 // Cheap rejections before the exact test: both ends strictly on one side of the triangle's
-// plane, or the point where the segment meets that plane outside the triangle's box.
-bool may_meet(const std::array<Vec3, 2>& box, double sp, double sq, const Vec3& p, const Vec3& q) {
+// plane, or the point where the segment meets that plane outside the triangle's box. Inlined:
+// tens of millions of calls per simulated ms, most rejected by the first line.
+[[gnu::always_inline]] inline bool may_meet(const std::array<Vec3, 2>& box, double sp, double sq, const Vec3& p, const Vec3& q) {
   if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0)) return false;
   const double denominator = sp - sq;
   if (denominator == 0.0) return true;  // in the plane: let the exact test decide
@@ -57,36 +59,93 @@ bool may_meet(const std::array<Vec3, 2>& box, double sp, double sq, const Vec3& 
   return true;
 }
 
+// Signed distance of x from triangle t's plane (the cheap rejection's input; the one
+// expression for it, so that a cached value is the value recomputed).
+double plane_side(const std::vector<Vec3>& normal, const std::vector<double>& offset, std::uint32_t t, const Vec3& x) {
+  return dot(normal[t], x) - offset[t];
+}
+
 // Whether the segment p -> q meets any of the triangles (touching counts).
 bool crosses_any(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles, const std::vector<Vec3>& normal,
                  const std::vector<double>& offset, const std::vector<std::array<Vec3, 2>>& boxes, const Vec3& p,
                  const Vec3& q) {
-  thread_local std::vector<std::uint32_t> one(1);
   for (const std::uint32_t t : triangles) {
-    const double sp = dot(normal[t], p) - offset[t], sq = dot(normal[t], q) - offset[t];
+    const double sp = plane_side(normal, offset, t, p), sq = plane_side(normal, offset, t, q);
     if (!may_meet(boxes[t], sp, sq, p, q)) continue;
-    one[0] = t;
-    if (first_crossing(mesh, one, p, q)) return true;
+    if (crossing(mesh, t, p, q)) return true;
   }
   return false;
 }
 
 // The same over candidates sorted by their distance from p (`distances`, one per triangle, or
 // none: then all are tested): a triangle the segment meets lies within `reach` of p, so the scan
-// stops at the first farther one. Exact, the answer is that of crosses_any.
+// stops at the first farther one. `p_sides`: p's plane_side per candidate when cached at the
+// classify (or null). Exact, the answer is that of crosses_any.
 bool crosses_any_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles, const std::vector<double>* distances,
-                        double reach, const std::vector<Vec3>& normal, const std::vector<double>& offset,
+                        const double* p_sides, double reach, const std::vector<Vec3>& normal, const std::vector<double>& offset,
                         const std::vector<std::array<Vec3, 2>>& boxes, const Vec3& p, const Vec3& q) {
   if (distances == nullptr || distances->size() != triangles.size()) return crosses_any(mesh, triangles, normal, offset, boxes, p, q);
-  thread_local std::vector<std::uint32_t> one(1);
   for (std::size_t k = 0; k < triangles.size() && (*distances)[k] <= reach; ++k) {
     const std::uint32_t t = triangles[k];
-    const double sp = dot(normal[t], p) - offset[t], sq = dot(normal[t], q) - offset[t];
+    const double sp = p_sides != nullptr ? p_sides[k] : plane_side(normal, offset, t, p), sq = plane_side(normal, offset, t, q);
     if (!may_meet(boxes[t], sp, sq, p, q)) continue;
-    one[0] = t;
-    if (first_crossing(mesh, one, p, q)) return true;
+    if (crossing(mesh, t, p, q)) return true;
   }
   return false;
+}
+
+// One particle's candidates scattered by triangle (distance and plane side; distance +inf for
+// the other triangles), per thread: the other end of a pair looks its triangles up in it.
+struct ScatteredCandidates {
+  const void* model = nullptr;
+  std::uint64_t generation = 0;
+  std::uint32_t particle = std::numeric_limits<std::uint32_t>::max();
+  std::vector<double> distance, side;
+  std::vector<std::uint32_t> triangles;  // the ones set, to reset
+
+  bool holds(const void* m, std::uint64_t g, std::uint32_t i) const { return model == m && generation == g && particle == i; }
+  void fill(const void* m, std::uint64_t g, std::uint32_t i, std::size_t mesh_triangles, const std::vector<std::uint32_t>& cand,
+            const std::vector<double>& cand_distance, const double* cand_side) {
+    if (model != m || distance.size() != mesh_triangles) {
+      distance.assign(mesh_triangles, std::numeric_limits<double>::infinity());
+      side.assign(mesh_triangles, 0.0);
+    } else {
+      for (const std::uint32_t t : triangles) distance[t] = std::numeric_limits<double>::infinity();
+    }
+    for (std::size_t k = 0; k < cand.size(); ++k) {
+      distance[cand[k]] = cand_distance[k];
+      side[cand[k]] = cand_side[k];
+    }
+    triangles = cand;
+    model = m;
+    generation = g;
+    particle = i;
+  }
+};
+
+// Whether the segment p -> q meets a triangle near both ends: the candidates of one end (`list`,
+// distances ascending, its plane sides; it is p when list_is_p) up to list_reach, each looked up
+// in the other end's scatter and kept only within other_reach of it and with the two distances'
+// sum within `bound` (a triangle met at m is within |pm| of p and |mq| of q). The same plane test
+// and exact test on the same values as crosses_any_within decide those kept.
+bool crosses_common(const TriangleMesh& mesh, const std::vector<std::array<Vec3, 2>>& boxes, const std::vector<std::uint32_t>& list,
+                    const std::vector<double>& dist, const double* sides, double list_reach, bool list_is_p,
+                    const ScatteredCandidates& other, double other_reach, double bound, const Vec3& p, const Vec3& q) {
+  for (std::size_t k = 0; k < list.size() && dist[k] <= list_reach; ++k) {
+    const std::uint32_t t = list[k];
+    const double d = other.distance[t];
+    if (d > other_reach || dist[k] + d > bound) continue;
+    const double sp = list_is_p ? sides[k] : other.side[t], sq = list_is_p ? other.side[t] : sides[k];
+    if (!may_meet(boxes[t], sp, sq, p, q)) continue;
+    if (crossing(mesh, t, p, q)) return true;
+  }
+  return false;
+}
+
+// Fresh for every classify (of any model): tells the per-thread caches that they are stale.
+std::uint64_t next_generation() {
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
 }
 
 // Length of the shortest path from a to b through a point of the segment [p, q]. The sum of the
@@ -327,6 +386,7 @@ void ThinWallModel3D::place_mesh() {
     mesh_acceleration_[k] = to_image(map, dyn_.a[j]);
   }
   mesh_.update();
+  buckets_current_ = false;  // until the next classify
   face_normal_.resize(mesh_.triangles.size());
   face_offset_.resize(mesh_.triangles.size());
   face_box_ = triangle_boxes(mesh_);
@@ -439,7 +499,12 @@ void ThinWallModel3D::classify(const Particles<3>& p) {
   if (s.side_by_id.size() <= max_id) s.side_by_id.resize(max_id + 1, 0);
   if (s.corrected_by_id.size() <= max_id) s.corrected_by_id.resize(max_id + 1, 0);
   const double R = fluid_.support_radius();
+  s.candidate_side.resize(n);
+  s.classified_position.resize(n);
   buckets_.build(face_box_, R);
+  buckets_.cache_neighbourhoods();  // one gather and sort per cell, not per particle
+  buckets_current_ = true;
+  generation_ = next_generation();
   Vec3 lo = mesh_.position[0], hi = mesh_.position[0];
   for (const auto& x : mesh_.position)
     for (int d = 0; d < 3; ++d) {
@@ -450,29 +515,38 @@ void ThinWallModel3D::classify(const Particles<3>& p) {
   const auto count = static_cast<std::ptrdiff_t>(n);
 #pragma omp parallel reduction(+ : leaks)
   {
-    std::vector<std::uint32_t> boxed;
+    std::vector<std::uint32_t> boxed, nearest(1);
 #pragma omp for schedule(dynamic, 256)
     for (std::ptrdiff_t ii = 0; ii < count; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       auto& cand = s.candidates[i];
       auto& cand_distance = s.candidate_distance[i];
+      auto& cand_side = s.candidate_side[i];
       cand.clear();
       cand_distance.clear();
+      cand_side.clear();
+      const Vec3 x = position_of(p, i);
+      s.classified_position[i] = x;
       if (p.kind[i] == Kind::lost) continue;
       const std::uint32_t id = p.id[i];
-      const Vec3 x = position_of(p, i);
       bool outside = false;
       for (int d = 0; d < 3; ++d) outside = outside || x[d] < lo[d] || x[d] > hi[d];
       if (!outside) {
-        buckets_.query({x[0] - R, x[1] - R, x[2] - R}, {x[0] + R, x[1] + R, x[2] + R}, boxed);
-        triangles_within(mesh_, boxed, x, R, cand, cand_distance);
+        // A superset of the buckets' answer for the support round x: the same triangles within R.
+        const auto around = buckets_.around({x[0] - R, x[1] - R, x[2] - R}, {x[0] + R, x[1] + R, x[2] + R}, boxed);
+        triangles_within(mesh_, face_box_, around, x, R, cand, cand_distance);
+        cand_side.resize(cand.size());
+        for (std::size_t k = 0; k < cand.size(); ++k) cand_side[k] = plane_side(face_normal_, face_offset_, cand[k], x);
       }
       if (cand.empty()) {
         if (p.kind[i] == Kind::fluid) s.side_by_id[id] = 0;
         continue;
       }
       NearWall& nw = s.near[i];
-      nw.closest = closest_point(mesh_, cand, x);
+      // The candidates come nearest first, by the distance closest_point computes (ties by
+      // index): the first is its answer, without the other candidates' distances again.
+      nearest[0] = cand[0];
+      nw.closest = closest_point(mesh_, nearest, x);
       nw.near = true;
       if (p.kind[i] != Kind::fluid) continue;
       // A particle may change side only round a free edge or through a put-back; otherwise
@@ -502,7 +576,40 @@ bool ThinWallModel3D::blocked(std::uint32_t a, std::uint32_t b, const Particles<
   // A triangle met at m is within |am| of a while b is at least its distance d_b from the mesh
   // away from m: only a's candidates within |ab| - d_b can be met (the margin covers rounding).
   const double reach = ab - near[b].closest.distance + reach_margin();
-  return crosses_any_within(mesh_, dyn_.candidates[a], distances_of(a), reach, face_normal_, face_offset_, face_box_, xa, xb);
+  const double* sides_a = sides_of(a, xa);
+  const double* sides_b = sides_of(b, xb);
+  if (sides_a == nullptr || sides_b == nullptr || distances_of(a) == nullptr || distances_of(b) == nullptr || !(ab < R - reach_margin()))
+    return crosses_any_within(mesh_, dyn_.candidates[a], distances_of(a), sides_a, reach, face_normal_, face_offset_, face_box_, xa, xb);
+  // Closer still: a triangle met at m is within |am| of a and |mb| of b, so (|ab| < R) it is a
+  // candidate of both with d_a + d_b <= |ab|, a thin ellipsoid round the segment. With one
+  // end's candidates scattered by triangle, the other end's list drops the rest by a look-up.
+  // The same plane test and exact test on the same values decide the few left: the answer of
+  // crosses_any_within (these triangles are a subset of its own, the rest cannot be met).
+  const double bound = ab + 2.0 * reach_margin();
+  thread_local std::array<ScatteredCandidates, 2> slots;
+  thread_local std::uint32_t last_b = std::numeric_limits<std::uint32_t>::max();
+  thread_local int next_slot = 0;
+  const ScatteredCandidates* of_a = nullptr;
+  const ScatteredCandidates* of_b = nullptr;
+  for (const auto& slot : slots) {
+    if (slot.holds(this, generation_, a)) of_a = &slot;
+    if (slot.holds(this, generation_, b)) of_b = &slot;
+  }
+  if (of_a == nullptr && of_b == nullptr) {
+    // Scatter the end that repeats: b when the caller sweeps many a against one b, else a.
+    const std::uint32_t i = b == last_b ? b : a;
+    ScatteredCandidates& slot = slots[static_cast<std::size_t>(next_slot)];
+    next_slot = 1 - next_slot;
+    slot.fill(this, generation_, i, mesh_.triangles.size(), dyn_.candidates[i], dyn_.candidate_distance[i], i == a ? sides_a : sides_b);
+    (i == a ? of_a : of_b) = &slot;
+  }
+  last_b = b;
+  const double inf = std::numeric_limits<double>::infinity();
+  if (of_a != nullptr)  // b's list (within bound - d_a of b, as d_a <= D_a), a's look-ups
+    return crosses_common(mesh_, face_box_, dyn_.candidates[b], dyn_.candidate_distance[b], sides_b, bound - near[a].closest.distance,
+                          false, *of_a, reach, bound, xa, xb);
+  return crosses_common(mesh_, face_box_, dyn_.candidates[a], dyn_.candidate_distance[a], sides_a, reach, true, *of_b, inf, bound, xa,
+                        xb);
 }
 
 void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGrid<3>& grid) {
@@ -520,6 +627,12 @@ void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGri
       const double nl = norm(nm);
       nm = {nm[0] / nl, nm[1] / nl, nm[2] / nl};
       const Vec3 am = settings_.wall_acceleration_in_pressure ? dyn_.a[j] : Vec3{0, 0, 0};
+      // The triangles near the node seen from each side, scattered once for all its particles
+      // (as the blocking's per-particle scatter: a triangle between b and the node is near both).
+      thread_local std::array<ScatteredCandidates, 2> seen_from;
+      thread_local std::vector<std::uint32_t> near_node, boxed;
+      thread_local std::vector<double> near_node_distance, near_node_side;
+      std::array<bool, 2> scattered{false, false};
       std::array<NeighbourSegment<3>, 27> segments;
       const int segment_count = grid.neighbour_segments(cell_of_point(grid, xm), segments);
       double sw[2] = {0, 0}, sp[2] = {0, 0}, srr[2][3] = {}, sv[2][3] = {};
@@ -535,9 +648,30 @@ void ThinWallModel3D::update_surface_states(const Particles<3>& p, const CellGri
           // The node as seen from b's side: nothing of the mesh may lie in between.
           const Vec3 target{xm[0] + side * tiny * nm[0], xm[1] + side * tiny * nm[1], xm[2] + side * tiny * nm[2]};
           const bool shifted = seg.shift[0] != 0 || seg.shift[1] != 0 || seg.shift[2] != 0;  // candidates are b's own
-          const double reach = shifted ? std::numeric_limits<double>::infinity() : norm(sub(target, xb)) + reach_margin();
-          if (crosses_any_within(mesh_, s.candidates[b], distances_of(b), reach, face_normal_, face_offset_, face_box_, xb, target))
+          const double to_target = norm(sub(target, xb));
+          const double reach = shifted ? std::numeric_limits<double>::infinity() : to_target + reach_margin();
+          const double* sides_b = shifted ? nullptr : sides_of(b, xb);
+          const int k_seen = side_index(side);
+          if (sides_b != nullptr && distances_of(b) != nullptr && buckets_current_ && to_target < R - reach_margin()) {
+            ScatteredCandidates& seen = seen_from[static_cast<std::size_t>(k_seen)];
+            if (!scattered[static_cast<std::size_t>(k_seen)]) {
+              const Vec3 lower{target[0] - R, target[1] - R, target[2] - R}, upper{target[0] + R, target[1] + R, target[2] + R};
+              const auto around = buckets_.around(lower, upper, boxed);
+              triangles_within(mesh_, face_box_, around, target, R, near_node, near_node_distance);
+              near_node_side.resize(near_node.size());
+              for (std::size_t k = 0; k < near_node.size(); ++k)
+                near_node_side[k] = plane_side(face_normal_, face_offset_, near_node[k], target);
+              seen.fill(this, 0, static_cast<std::uint32_t>(j), mesh_.triangles.size(), near_node, near_node_distance,
+                        near_node_side.data());
+              scattered[static_cast<std::size_t>(k_seen)] = true;
+            }
+            if (crosses_common(mesh_, face_box_, s.candidates[b], s.candidate_distance[b], sides_b, reach, true, seen,
+                               std::numeric_limits<double>::infinity(), to_target + 2.0 * reach_margin(), xb, target))
+              continue;
+          } else if (crosses_any_within(mesh_, s.candidates[b], distances_of(b), sides_of(b, xb), reach, face_normal_, face_offset_,
+                                        face_box_, xb, target)) {
             continue;
+          }
           const double w = W.value(static_cast<float>(dist));
           const int k = side_index(side);
           const double rho_b = fluid_.rest_density + p.density_excess[b];
@@ -591,8 +725,9 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
 #pragma omp parallel
     {
       Vec3* forces = per_thread.data() + static_cast<std::size_t>(omp_get_thread_num()) * node_count_;
-      std::vector<double> side_a;  // signed distance of the particle from each candidate's plane
+      std::vector<double> side_scratch;  // signed distance of the particle from each candidate's plane
       std::vector<ClosestPoint3> sheets;
+      std::vector<std::uint32_t> one;  // one sheet's candidates
       std::vector<std::array<Vec3, 2>> free_edges;
       // Static chunks: each thread's share, and so the node loads' summation order, is the
       // same in every run with the same thread count (restarts continue bit for bit).
@@ -603,15 +738,18 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
         const auto& cand = s.candidates[a];
         const std::vector<double>* cand_distance = distances_of(a);
         const Vec3 xa = position_of(p, a);
-        side_a.resize(cand.size());
-        for (std::size_t k = 0; k < cand.size(); ++k) side_a[k] = dot(face_normal_[cand[k]], xa) - face_offset_[cand[k]];
+        const double* side_a = sides_of(a, xa);  // as cached at the classify, or the same values now
+        if (side_a == nullptr) {
+          side_scratch.resize(cand.size());
+          for (std::size_t k = 0; k < cand.size(); ++k) side_scratch[k] = plane_side(face_normal_, face_offset_, cand[k], xa);
+          side_a = side_scratch.data();
+        }
         const double rho_a = rho0 + p.density_excess[a];
         const double inv_a = 1.0 / rho_a;
         const double p_a = p.pressure[a];
         const Vec3 va{p.velocity[0][a], p.velocity[1][a], p.velocity[2][a]};
         const Vec3 vva{p.viscous_velocity[0][a], p.viscous_velocity[1][a], p.viscous_velocity[2][a]};
         double acc[3] = {0, 0, 0}, cont = 0, csum = 0, cg[3] = {0, 0, 0};
-        std::vector<std::uint32_t> one(1);
         // The free edges within the support (experiment fluid_state_round_free_edge).
         free_edges.clear();
         if (settings_.fluid_state_round_free_edge)
@@ -640,12 +778,10 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
             if (hidden || sheet_of_triangle_[t] == piece) continue;
             const double sp = dot(face_normal_[t], xa) - face_offset_[t], sq = dot(face_normal_[t], other.point) - face_offset_[t];
             if (!may_meet(face_box_[t], sp, sq, xa, other.point)) continue;
-            one.assign(1, t);
-            hidden = first_crossing(mesh_, one, xa, other.point).has_value();
+            hidden = crossing(mesh_, t, xa, other.point).has_value();
           }
           if (other.distance < R && !hidden) sheets.push_back(other);
         }
-        one.resize(1);
         for (std::size_t sheet = 0; sheet < sheets.size(); ++sheet) {
         const ClosestPoint3& c = sheets[sheet];
         if (c.on_boundary && !settings_.lattice_beyond_free_edge) continue;
@@ -676,8 +812,20 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
         for (int l = first_layer; l <= layers; ++l) {
           const double depth = first_depth + (l - 1) * delta;
           if (depth <= -nl) continue;  // not beyond the particle's own position
-          for (int i = -layers; i <= layers; ++i)
-            for (int j = -layers; j <= layers; ++j) {
+          // x_a - x_v = (nl + depth) n - i delta t1 - j delta t2 (n, t1, t2 orthonormal), so only
+          // |i|, |j| within the layer's disc can pass the r2 test below: the rest are skipped
+          // before computing them. The bound is widened by 1e-6 of R^2, far above the rounding
+          // of r2 and the particle's offset from the axis when nl ~ 0 (1e-9 dp): the points
+          // tested, and their order, are those that passed before.
+          const double along = nl + depth;
+          const double room = R * R * (1.0 + 1e-6) - along * along;
+          if (room < 0.0) continue;
+          const int span_i = std::min(layers, static_cast<int>(std::sqrt(room) / delta));
+          for (int i = -span_i; i <= span_i; ++i) {
+            const double room_i = room - (i * delta) * (i * delta);
+            if (room_i < 0.0) continue;
+            const int span_j = std::min(layers, static_cast<int>(std::sqrt(room_i) / delta));
+            for (int j = -span_j; j <= span_j; ++j) {
               Vec3 xv;
               for (int d = 0; d < 3; ++d) xv[d] = c.point[d] + i * delta * t1[d] + j * delta * t2[d] - depth * n[d];
               const Vec3 r = sub(xa, xv);
@@ -700,8 +848,7 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
                 const std::uint32_t t = cand[k];
                 const double sv = dot(face_normal_[t], xv) - face_offset_[t];
                 if (!may_meet(face_box_[t], side_a[k], sv, xa, xv)) continue;
-                one[0] = t;
-                hit = first_crossing(mesh_, one, xa, xv);
+                hit = crossing(mesh_, t, xa, xv);
               }
               if (!hit) continue;
               if (only_piece >= 0 && sheet_of_triangle_[hit->triangle] != only_piece) continue;  // another sheet's shadow
@@ -767,6 +914,7 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
                 for (int d = 0; d < 3; ++d) f[d] += w * load[d];
               }
             }
+          }
         }
         }
         for (int d = 0; d < 3; ++d) p.acceleration[d][a] += static_cast<float>(acc[d]);
@@ -790,7 +938,8 @@ bool ThinWallModel3D::accept_shift(const Particles<3>& p, std::size_t i, const V
   const Vec3 x = position_of(p, i);
   const Vec3 y{x[0] + shift[0], x[1] + shift[1], x[2] + shift[2]};
   const double reach = std::sqrt(shift[0] * shift[0] + shift[1] * shift[1] + shift[2] * shift[2]) + reach_margin();
-  bool ok = !crosses_any_within(mesh_, s.candidates[i], distances_of(i), reach, face_normal_, face_offset_, face_box_, x, y);
+  bool ok =
+      !crosses_any_within(mesh_, s.candidates[i], distances_of(i), sides_of(i, x), reach, face_normal_, face_offset_, face_box_, x, y);
   if (ok) {
     const double after = closest_point(mesh_, s.candidates[i], y).distance;
     ok = !(after < clearance_ && after < s.near[i].closest.distance);
@@ -830,6 +979,7 @@ void ThinWallModel3D::save_checkpoint() { checkpoint_ = dyn_; }
 void ThinWallModel3D::restore_checkpoint() {
   if (!checkpoint_) throw std::logic_error("thin wall 3D restore_checkpoint: no checkpoint was saved");
   dyn_ = *checkpoint_;
+  generation_ = next_generation();
   place_mesh();
 }
 
@@ -907,6 +1057,8 @@ void ThinWallModel3D::load_restart_state(std::span<const NamedArray> arrays) {
   }
   s.candidates = in.lists("particles.candidates", near.size());
   s.candidate_distance.clear();  // not stored: the next classify rebuilds them (until then every candidate is tested)
+  s.candidate_side.clear();
+  s.classified_position.clear();
   for (const auto& list : s.candidates)
     for (const auto t : list)
       if (t >= mesh_.triangles.size())
@@ -925,6 +1077,7 @@ void ThinWallModel3D::load_restart_state(std::span<const NamedArray> arrays) {
   const auto counters = in.scalars<std::size_t>("counters", 3);
   s.counters = {counters[0], counters[1], counters[2]};
   dyn_ = std::move(s);
+  generation_ = next_generation();
   place_mesh();
 }
 

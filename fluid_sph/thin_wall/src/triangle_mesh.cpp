@@ -182,6 +182,13 @@ std::optional<Crossing3> first_crossing(const TriangleMesh& mesh, const std::vec
   return best;
 }
 
+std::optional<Crossing3> crossing(const TriangleMesh& mesh, std::size_t t, const Vec3& p, const Vec3& q) {
+  const Vec3 d = sub(q, p);
+  Crossing3 hit;
+  if (segment_meets_triangle(mesh, t, p, d, norm(d), hit)) return hit;
+  return std::nullopt;
+}
+
 std::optional<Crossing3> first_crossing(const TriangleMesh& mesh, const Vec3& p, const Vec3& q) {
   std::optional<Crossing3> best;
   const Vec3 d = sub(q, p);
@@ -269,6 +276,8 @@ void TriangleBuckets::build(const std::vector<std::array<Vec3, 2>>& boxes, doubl
   if (boxes.empty()) lo = hi = {0, 0, 0};
   origin_ = lo;
   inv_cell_ = 1.0 / cell_size;
+  near_start_.clear();  // the neighbourhoods of the last build
+  near_items_.clear();
   for (int d = 0; d < 3; ++d) count_[d] = std::max(1, static_cast<int>(std::floor((hi[d] - lo[d]) * inv_cell_)) + 1);
   const std::size_t cells = static_cast<std::size_t>(count_[0]) * static_cast<std::size_t>(count_[1]) * static_cast<std::size_t>(count_[2]);
   start_.assign(cells + 1, 0);
@@ -300,25 +309,74 @@ void TriangleBuckets::build(const std::vector<std::array<Vec3, 2>>& boxes, doubl
   }
 }
 
+bool TriangleBuckets::cell_range(const Vec3& lower, const Vec3& upper, std::array<int, 3>& l, std::array<int, 3>& u) const {
+  for (int d = 0; d < 3; ++d) {
+    const double a = std::floor((lower[d] - origin_[d]) * inv_cell_), b = std::floor((upper[d] - origin_[d]) * inv_cell_);
+    if (b < 0 || a > count_[d] - 1) return false;  // outside the grid: no triangle there
+    l[d] = static_cast<int>(std::max(a, 0.0));
+    u[d] = static_cast<int>(std::min(b, static_cast<double>(count_[d] - 1)));
+  }
+  return true;
+}
+
 void TriangleBuckets::query(const Vec3& lower, const Vec3& upper, std::vector<std::uint32_t>& out) const {
   out.clear();
   if (start_.empty()) return;
   std::array<int, 3> l{}, u{};
-  for (int d = 0; d < 3; ++d) {
-    const double a = std::floor((lower[d] - origin_[d]) * inv_cell_), b = std::floor((upper[d] - origin_[d]) * inv_cell_);
-    if (b < 0 || a > count_[d] - 1) return;  // outside the grid: no triangle there
-    l[d] = static_cast<int>(std::max(a, 0.0));
-    u[d] = static_cast<int>(std::min(b, static_cast<double>(count_[d] - 1)));
-  }
+  if (!cell_range(lower, upper, l, u)) return;
   for (int k = l[2]; k <= u[2]; ++k)
     for (int j = l[1]; j <= u[1]; ++j)
       for (int i = l[0]; i <= u[0]; ++i) {
-        const std::size_t c = (static_cast<std::size_t>(k) * static_cast<std::size_t>(count_[1]) + static_cast<std::size_t>(j)) *
-                                  static_cast<std::size_t>(count_[0]) + static_cast<std::size_t>(i);
+        const std::size_t c = cell_index(i, j, k);
         out.insert(out.end(), items_.begin() + start_[c], items_.begin() + start_[c + 1]);
       }
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+void TriangleBuckets::cache_neighbourhoods() {
+  near_start_.clear();
+  near_items_.clear();
+  if (start_.empty()) return;
+  near_start_.reserve(start_.size());
+  near_start_.push_back(0);
+  std::vector<std::uint32_t> list;
+  for (int k = 0; k < count_[2]; ++k)  // in cell_index order
+    for (int j = 0; j < count_[1]; ++j)
+      for (int i = 0; i < count_[0]; ++i) {
+        list.clear();
+        for (int kk = std::max(k - 1, 0); kk <= std::min(k + 1, count_[2] - 1); ++kk)
+          for (int jj = std::max(j - 1, 0); jj <= std::min(j + 1, count_[1] - 1); ++jj)
+            for (int ii = std::max(i - 1, 0); ii <= std::min(i + 1, count_[0] - 1); ++ii) {
+              const std::size_t c = cell_index(ii, jj, kk);
+              list.insert(list.end(), items_.begin() + start_[c], items_.begin() + start_[c + 1]);
+            }
+        std::sort(list.begin(), list.end());
+        list.erase(std::unique(list.begin(), list.end()), list.end());
+        near_items_.insert(near_items_.end(), list.begin(), list.end());
+        near_start_.push_back(static_cast<std::uint32_t>(near_items_.size()));
+      }
+}
+
+std::span<const std::uint32_t> TriangleBuckets::around(const Vec3& lower, const Vec3& upper, std::vector<std::uint32_t>& scratch) const {
+  std::array<int, 3> l{}, u{};
+  if (start_.empty() || !cell_range(lower, upper, l, u)) return {};  // query() finds none
+  if (!near_start_.empty()) {
+    std::array<int, 3> c{};
+    bool covered = true;
+    for (int d = 0; d < 3; ++d) {
+      const double centre = std::floor((0.5 * (lower[d] + upper[d]) - origin_[d]) * inv_cell_);
+      c[d] = static_cast<int>(std::clamp(centre, 0.0, static_cast<double>(count_[d] - 1)));
+      // The box's cells as query() rounds them, not as the centre's cell suggests.
+      covered = covered && l[d] >= c[d] - 1 && u[d] <= c[d] + 1;
+    }
+    if (covered) {
+      const std::size_t n = cell_index(c[0], c[1], c[2]);
+      return {near_items_.data() + near_start_[n], near_start_[n + 1] - near_start_[n]};
+    }
+  }
+  query(lower, upper, scratch);
+  return scratch;
 }
 
 std::vector<std::array<Vec3, 2>> triangle_boxes(const TriangleMesh& mesh, const std::vector<Vec3>* other) {
@@ -338,6 +396,45 @@ std::vector<std::array<Vec3, 2>> triangle_boxes(const TriangleMesh& mesh, const 
   return boxes;
 }
 
+namespace {
+
+void triangles_within_boxed(const TriangleMesh& mesh, const std::vector<std::array<Vec3, 2>>* boxes,
+                            std::span<const std::uint32_t> candidates, const Vec3& x, double radius, std::vector<std::uint32_t>& out,
+                            std::vector<double>& distances) {
+  out.clear();
+  distances.clear();
+  thread_local std::vector<std::pair<double, std::uint32_t>> found;
+  found.clear();
+  // A triangle is no nearer than its box; the margin keeps every triangle whose rounded
+  // distance could fall below the radius (rounding is ~1e-15 of it).
+  const double box_reject2 = radius * radius * (1.0 + 1e-9);
+  for (const std::uint32_t t : candidates) {
+    if (boxes != nullptr) {
+      const auto& b = (*boxes)[t];
+      double g2 = 0.0;
+      for (int d = 0; d < 3; ++d) {
+        const double g = std::max({b[0][d] - x[d], x[d] - b[1][d], 0.0});
+        g2 += g * g;
+      }
+      if (g2 > box_reject2) continue;
+    }
+    const TrianglePoint tp = closest_on_triangle(x, corner(mesh, t, 0), corner(mesh, t, 1), corner(mesh, t, 2));
+    Vec3 point{0, 0, 0};
+    for (int k = 0; k < 3; ++k) point = add(point, scale(corner(mesh, t, k), tp.barycentric[static_cast<std::size_t>(k)]));
+    const Vec3 r = sub(x, point);
+    const double d2 = dot(r, r);
+    if (d2 < radius * radius) found.push_back({d2, t});
+  }
+  // By (distance, triangle): the answer does not depend on the candidates' order or extras.
+  std::sort(found.begin(), found.end());
+  for (const auto& [d2, t] : found) {
+    out.push_back(t);
+    distances.push_back(std::sqrt(d2));
+  }
+}
+
+}  // namespace
+
 void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& candidates, const Vec3& x, double radius,
                       std::vector<std::uint32_t>& out) {
   thread_local std::vector<double> distances;
@@ -346,23 +443,13 @@ void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>
 
 void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& candidates, const Vec3& x, double radius,
                       std::vector<std::uint32_t>& out, std::vector<double>& distances) {
-  out.clear();
-  distances.clear();
-  thread_local std::vector<std::pair<double, std::uint32_t>> found;
-  found.clear();
-  for (const std::uint32_t t : candidates) {
-    const TrianglePoint tp = closest_on_triangle(x, corner(mesh, t, 0), corner(mesh, t, 1), corner(mesh, t, 2));
-    Vec3 point{0, 0, 0};
-    for (int k = 0; k < 3; ++k) point = add(point, scale(corner(mesh, t, k), tp.barycentric[static_cast<std::size_t>(k)]));
-    const Vec3 r = sub(x, point);
-    const double d2 = dot(r, r);
-    if (d2 < radius * radius) found.push_back({d2, t});
-  }
-  std::sort(found.begin(), found.end());
-  for (const auto& [d2, t] : found) {
-    out.push_back(t);
-    distances.push_back(std::sqrt(d2));
-  }
+  triangles_within_boxed(mesh, nullptr, candidates, x, radius, out, distances);
+}
+
+void triangles_within(const TriangleMesh& mesh, const std::vector<std::array<Vec3, 2>>& boxes,
+                      std::span<const std::uint32_t> candidates, const Vec3& x, double radius, std::vector<std::uint32_t>& out,
+                      std::vector<double>& distances) {
+  triangles_within_boxed(mesh, &boxes, candidates, x, radius, out, distances);
 }
 
 }  // namespace valvefsi::fluid::thin_wall

@@ -142,6 +142,10 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
     std::vector<NearWall> near;
     std::vector<std::vector<std::uint32_t>> candidates;
     std::vector<std::vector<double>> candidate_distance;  // per particle: its candidates' distances (ascending)
+    // Per particle, cached at the classify for the pair blocking: its signed distance from each
+    // candidate's plane, and where it was then (the cache holds while it has not moved).
+    std::vector<std::vector<double>> candidate_side;
+    std::vector<Vec3> classified_position;
     std::vector<std::int8_t> side_by_id;
     std::vector<std::uint8_t> corrected_by_id;
     std::vector<Vec3> previous_by_id;
@@ -156,6 +160,12 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
   const std::vector<double>* distances_of(std::size_t i) const {
     const auto& d = dyn_.candidate_distance;
     return i < d.size() && d[i].size() == dyn_.candidates[i].size() ? &d[i] : nullptr;
+  }
+  // Particle i's plane sides per candidate when x is still where the classify saw it, else
+  // nullptr (then recomputed: the same expression, the same answer).
+  const double* sides_of(std::size_t i, const Vec3& x) const {
+    const auto& c = dyn_.candidate_side;
+    return i < c.size() && c[i].size() == dyn_.candidates[i].size() && dyn_.classified_position[i] == x ? c[i].data() : nullptr;
   }
   // Slack on a distance bound for rounding (the triangle test's touching tolerance is 1e-12 of
   // a triangle): far below any distance the model resolves.
@@ -184,6 +194,8 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
   std::vector<double> face_offset_;  // normal . first corner
   std::vector<std::array<Vec3, 2>> face_box_;  // bounding box per mesh triangle
   TriangleBuckets buckets_;
+  bool buckets_current_ = false;  // built for the mesh as it is placed now
+  std::uint64_t generation_ = 0;  // of the per-particle data (new at each classify or restore): keys the blocking's per-thread caches
   NodeLoadSmoother smoother_;
   Dynamic dyn_;
   std::optional<Dynamic> checkpoint_;

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 namespace valvefsi::fluid::thin_wall {
@@ -69,6 +70,8 @@ std::optional<Crossing3> first_crossing(const TriangleMesh& mesh, const Vec3& p,
 // The same over a subset of triangles (candidates from a spatial search).
 std::optional<Crossing3> first_crossing(const TriangleMesh& mesh, const std::vector<std::uint32_t>& triangles, const Vec3& p,
                                         const Vec3& q);
+// The same for one triangle (the answer of first_crossing over {t}, without the list).
+std::optional<Crossing3> crossing(const TriangleMesh& mesh, std::size_t t, const Vec3& p, const Vec3& q);
 
 // Continuous test over a step: the point moves x0 -> x1 and the nodes before -> after, all
 // linearly in tau in [0, 1]. A root of the coplanarity cubic counts when the point is inside
@@ -93,11 +96,28 @@ class TriangleBuckets {
   // Triangles whose box may overlap [lower, upper], each once, ascending.
   void query(const Vec3& lower, const Vec3& upper, std::vector<std::uint32_t>& out) const;
 
+  // Per-build cache for many boxes of at most one cell a side (a support round each particle):
+  // per cell, the triangles of it and its 26 neighbours, each once, ascending, so that a query
+  // is a look-up instead of a gather and sort.
+  void cache_neighbourhoods();
+  // A superset of query(lower, upper)'s answer, each once, ascending: the cached list of the
+  // cell of the box's centre when its neighbourhood covers the box's cells (else query()'s own
+  // answer, in `scratch`). Exact for callers that keep only the triangles meeting a test.
+  std::span<const std::uint32_t> around(const Vec3& lower, const Vec3& upper, std::vector<std::uint32_t>& scratch) const;
+
  private:
+  // The cells query() visits for [lower, upper] (false: none, the box is outside the grid).
+  bool cell_range(const Vec3& lower, const Vec3& upper, std::array<int, 3>& l, std::array<int, 3>& u) const;
+  std::size_t cell_index(int i, int j, int k) const {
+    return (static_cast<std::size_t>(k) * static_cast<std::size_t>(count_[1]) + static_cast<std::size_t>(j)) *
+               static_cast<std::size_t>(count_[0]) + static_cast<std::size_t>(i);
+  }
+
   Vec3 origin_{};
   double inv_cell_ = 1.0;
   std::array<int, 3> count_{};
   std::vector<std::uint32_t> start_, items_;
+  std::vector<std::uint32_t> near_start_, near_items_;  // the neighbourhoods (empty: not cached)
 };
 
 // Bounding boxes of every triangle over one or two node sets (before and after a move).
@@ -110,5 +130,10 @@ void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>
 // a segment from x of length L can only meet the triangles with distance <= L.
 void triangles_within(const TriangleMesh& mesh, const std::vector<std::uint32_t>& candidates, const Vec3& x, double radius,
                       std::vector<std::uint32_t>& out, std::vector<double>& distances);
+// The same, skipping the candidates whose bounding box (triangle_boxes) is farther than
+// `radius` (with a margin far above round-off): the same answer for less exact distances.
+void triangles_within(const TriangleMesh& mesh, const std::vector<std::array<Vec3, 2>>& boxes,
+                      std::span<const std::uint32_t> candidates, const Vec3& x, double radius, std::vector<std::uint32_t>& out,
+                      std::vector<double>& distances);
 
 }  // namespace valvefsi::fluid::thin_wall

@@ -28,8 +28,6 @@ from . import waveform
 from .tube_case import FSI_3D_PLATE_PRESSURE_RESERVE_MMHG
 
 RAMP_S = 0.030        # cosine ramp of the load: slower than the leaflet's closed period, faster than the cycle's 0.245 -> 0.36 s
-# The FSI variant's solid: generalized-alpha at this spectral radius, one step per window.
-CLOSED_FSI_SPECTRAL_RADIUS = 0.5
 END_TIME_S = 0.060    # the ramp and 30 ms held
 # the cycle's largest reverse transvalvular difference (p_Ao - p_LV) and when it occurs
 PEAK_REVERSE_TIME_S = 0.361
@@ -117,16 +115,7 @@ def case_text(kind: str, base_text: str) -> str:
     title = body[:title_end].replace('"\n', ', closed-valve load"\n', 1)
     run = re.sub(r"  end_time: [^\n]*\n", f"  end_time: {END_TIME_S:g}\n", body[run_start:waveform_start], count=1)
     run = re.sub(r"  output_dir: [^\n]*\n", f"  output_dir: \"runs/{name}\"\n", run, count=1)
-    rest = body[solid_start:]
-    if not fe:
-        # The implicit solid, one generalized-alpha step per coupling window: its numerical damping
-        # takes out the closed leaflet's modes above the window's rate, which the explicit solid let
-        # grow (leaflet kinetic energy 2.6 against 53 uJ at 28 ms; docs/fsi-3d.md, session 12).
-        window = re.search(r"  window_size: ([^\n]*)\n", rest).group(1)
-        solid_end = rest.index("\n}\n")
-        rest = (rest[:solid_end] + "\n  # one implicit step per coupling window (docs/fsi-3d.md, \"The implicit solid in coupled runs\")"
-                f"\n  time_integration: IMPLICIT\n  spectral_radius_infinity: {CLOSED_FSI_SPECTRAL_RADIUS:g}"
-                f"\n  max_time_step: {window}\n  implicit_initial_step_s: {window}" + rest[solid_end:])
+    rest = body[solid_start:]   # the solid, fluid and coupling as the cycle case (an FSI solid: implicit)
     return ("\n".join(_wrap_comment(line) for line in header) + "\n" + title + run + waveform_textproto() + rest)
 
 

@@ -131,12 +131,14 @@ def solid_block(spec: CaseSpec) -> str:
             "  fixed_node_sets: \"attachment\"\n"
             "  monitor_node_sets: \"free_edge_midpoints\"\n"
             + (fe_only_damping_lines(spec) if spec.kind == "FE" else "")
-            + stent_cylinder_lines() +
+            + stent_cylinder_lines()
+            + (fsi_implicit_solid_lines(PARTICLE_SPACING[spec.resolution]) if spec.kind == "FSI" and spec.variant == "sector" else "") +
             "}\n")
 
 
 FE_ONLY_MASS_DAMPING_PER_S = 20.0   # docs/fe-only-study.md: two undamped cycles stop on energy growth at ~0.86 s
 FSI_3D_PEER_TIMEOUT_S = 120.0       # s; a crashed peer is still found at once (closed connection)
+FSI_3D_RESTART_INTERVAL_S = 0.01    # s of simulated time; a cycle of the coarse sector takes hours
 FE_ONLY_RESTART_INTERVAL_S = 0.1    # long FE-only runs survive a stop (solid_fe --restart)
 # FE-only time integration of the sector cases (docs/solid_fe.md, "The switch on filtered kinetic
 # energy"): explicit while the leaflets move, implicit once the 1 ms low-pass-filtered kinetic
@@ -162,6 +164,27 @@ def fe_only_automatic_lines() -> str:
             "  time_integration: AUTOMATIC\n"
             f"  spectral_radius_infinity: {FE_ONLY_SPECTRAL_RADIUS_INFINITY:g}\n"
             f"  settled_filter_time_s: {FE_ONLY_SETTLED_FILTER_TIME_S:g}\n")
+
+
+# The coupled 3D solid: generalized-alpha, two steps per coupling window. Its numerical damping
+# takes out the closed leaflet's modes above the window's rate, which the explicit solid let grow
+# under the diastolic load (leaflet kinetic energy 2.6 against 53 uJ at 28 ms of the closed-load
+# scene). One step per window let the coaptation band's flutter grow in the opening (stopped at
+# 14.8 ms); two steps per window opened as the explicit solid does (docs/fsi-3d.md, session 13).
+# Sector cases only: the full valve's leaflet-leaflet contact held the implicit solver to
+# microsecond steps in FE-only runs (docs/solid_fe.md, "Twelfth session").
+FSI_3D_SPECTRAL_RADIUS_INFINITY = 0.5
+FSI_3D_SOLID_STEPS_PER_WINDOW = 2
+
+
+def fsi_implicit_solid_lines(particle_spacing: float) -> str:
+    from .tube_case import fsi_3d_coupling_window_s
+    step = f"{fsi_3d_coupling_window_s(particle_spacing) / FSI_3D_SOLID_STEPS_PER_WINDOW:.4g}"
+    return ("  # implicit, two steps per coupling window (docs/fsi-3d.md, \"The implicit solid in coupled runs\")\n"
+            "  time_integration: IMPLICIT\n"
+            f"  spectral_radius_infinity: {FSI_3D_SPECTRAL_RADIUS_INFINITY:g}\n"
+            f"  max_time_step: {step}\n"
+            f"  implicit_initial_step_s: {step}\n")
 
 
 def stent_radius() -> float:
@@ -190,6 +213,9 @@ def coupling_block(particle_spacing: float) -> str:
             "  # heartbeats went unheard on a machine at load 21 (docs/fsi-3d.md, session 7)\n"
             f"  peer_timeout_s: {FSI_3D_PEER_TIMEOUT_S:g}\n"
             "  mapping: NEAREST_PROJECTION\n"
+            "  # restart data every 10 ms of simulated time (~10 min of wall time for the coarse sector; the\n"
+            "  # newest two kept, 54 MB each): continue with `run_case.py CASE --restart OUTPUT/restart`\n"
+            f"  restart_interval_s: {FSI_3D_RESTART_INTERVAL_S:g}\n"
             "}\n")
 
 

@@ -48,6 +48,22 @@ class CaseFiles(unittest.TestCase):
             for got, want in zip(normals, expected):
                 np.testing.assert_allclose(got, want, atol=1e-14)
 
+    def test_sector_fsi_solid_takes_two_implicit_steps_per_window(self):
+        import re
+        for spec in all_specs():
+            text = case_text(spec)
+            solid = text[text.index("solid {"):text.index("\n}\n", text.index("solid {")) + 1]
+            implicit = "time_integration: IMPLICIT" in solid
+            self.assertEqual(implicit, spec.kind == "FSI" and spec.variant == "sector", spec.name)
+            if implicit:
+                # two steps per window: one let the opening's coaptation band flutter grow (docs/fsi-3d.md)
+                window = float(re.search(r"  window_size: ([^\n]*)\n", text).group(1))
+                step = float(re.search(r"  max_time_step: ([^\n]*)\n", solid).group(1))
+                first = float(re.search(r"  implicit_initial_step_s: ([^\n]*)\n", solid).group(1))
+                self.assertAlmostEqual(step / window, 0.5, delta=1e-9)
+                self.assertEqual(first, step)
+                self.assertIn("  spectral_radius_infinity: 0.5\n", solid)
+
     def test_every_3d_case_has_the_stent_cylinder(self):
         for spec in all_specs():
             self.assertIn(f"contact_cylinders {{ origin: [0, 0, 0] axis: [0, 0, 1] radius: {stent_radius():.6g} }}", case_text(spec))

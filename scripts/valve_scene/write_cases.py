@@ -139,6 +139,10 @@ def solid_block(spec: CaseSpec) -> str:
 FE_ONLY_MASS_DAMPING_PER_S = 20.0   # docs/fe-only-study.md: two undamped cycles stop on energy growth at ~0.86 s
 FSI_3D_PEER_TIMEOUT_S = 120.0       # s; a crashed peer is still found at once (closed connection)
 FSI_3D_RESTART_INTERVAL_S = 0.01    # s of simulated time; a cycle of the coarse sector takes hours
+# The coupler's standing-oscillation stop (docs/coupling.md): the sector's opening peaks at 1.02 m/s
+# and its closed-load scene at 1.94 m/s; the fluid CFL 0.21 failure stood at >= 5 m/s for 14 blocks.
+FSI_3D_RUNAWAY_STANDING_SPEED = 5.0  # m/s
+FSI_3D_RUNAWAY_STANDING_BLOCKS = 8   # blocks of 16 windows (1.3 ms at the coarse window)
 FE_ONLY_RESTART_INTERVAL_S = 0.1    # long FE-only runs survive a stop (solid_fe --restart)
 # FE-only time integration of the sector cases (docs/solid_fe.md, "The switch on filtered kinetic
 # energy"): explicit while the leaflets move, implicit once the 1 ms low-pass-filtered kinetic
@@ -216,6 +220,10 @@ def coupling_block(particle_spacing: float) -> str:
             "  # restart data every 10 ms of simulated time (~10 min of wall time for the coarse sector; the\n"
             "  # newest two kept, 54 MB each): continue with `run_case.py CASE --restart OUTPUT/restart`\n"
             f"  restart_interval_s: {FSI_3D_RESTART_INTERVAL_S:g}\n"
+            "  # an oscillation at the window's scale that stands at >= 5 m/s for 8 blocks of 16 windows stops\n"
+            "  # the run (physical: <= 1.02 m/s opening, <= 1.94 closed; the CFL 0.21 failure stood at 9 m/s)\n"
+            f"  runaway_standing_speed: {FSI_3D_RUNAWAY_STANDING_SPEED:g}\n"
+            f"  runaway_standing_blocks: {FSI_3D_RUNAWAY_STANDING_BLOCKS}\n"
             "}\n")
 
 

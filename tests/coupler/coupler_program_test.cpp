@@ -41,6 +41,8 @@ TEST(CouplerSettings, DefaultsFromAnEmptyCouplingSection) {
   EXPECT_DOUBLE_EQ(settings.max_interface_speed, 20.0);
   EXPECT_DOUBLE_EQ(settings.runaway_oscillation_speed, 0.5);
   EXPECT_EQ(settings.runaway_growing_blocks, 12);
+  EXPECT_EQ(settings.runaway_standing_speed, 0.0);
+  EXPECT_EQ(settings.runaway_standing_blocks, 8);
   EXPECT_EQ(settings.mapping.method, coupling::MappingMethod::nearest_projection);
 }
 

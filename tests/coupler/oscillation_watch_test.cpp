@@ -2,7 +2,8 @@
 // velocity histories with known answers: a motion smooth over a window is not an oscillation,
 // however fast or fast-growing; a period-4 mode (the serial-explicit piston's at mu = 2) is
 // measured exactly; a jolt and a steady oscillation are not runaways; a growing period-4 mode
-// fires at the first block above the floor, having grown by exactly r^16 per block.
+// fires at the first block above the floor, having grown by exactly r^16 per block; an
+// oscillation that saturates at once and stands is caught by the standing rule, a shorter jolt is not.
 
 #include <gtest/gtest.h>
 
@@ -102,6 +103,31 @@ TEST(OscillationWatch, GrowthTooSlowOverTheBlocksDoesNotFire) {
   const double r = std::sqrt(1.0025);
   OscillationWatch watch(0.5, 4);
   EXPECT_FALSE(feed(watch, 4000, [&](int n) { return 0.4 * std::pow(r, n) * std::cos(std::numbers::pi * n / 2.0); }));
+}
+
+TEST(OscillationWatch, SaturatedOscillationIsStoppedByTheStandingRuleAndAJoltIsNot) {
+  // Period-4 mode that jumps to amplitude 6 within a block and stays (as the 3D sector's fluid
+  // CFL 0.21 run did): sqrt(2) x 6 = 8.5 m/s per block, level, so the growth rule never fires.
+  const auto saturated = [](int n) { return (n < 40 ? 0.01 : 6.0) * std::cos(std::numbers::pi * n / 2.0); };
+  OscillationWatch growth_only(0.5, 12);
+  EXPECT_FALSE(feed(growth_only, 100 * kBlock, saturated));
+  OscillationWatch standing(0.5, 12, 5.0, 8);
+  const auto fired = feed(standing, 100 * kBlock, saturated);
+  ASSERT_TRUE(fired);
+  EXPECT_TRUE(fired->alarm.standing);
+  EXPECT_EQ(fired->alarm.blocks, 8);
+  EXPECT_NEAR(fired->alarm.oscillation, std::sqrt(2.0) * 6.0, 1e-12);
+  // Block k holds windows 2 + 16k ... 17 + 16k. Block 2 (windows 34-49) takes the jump at 40
+  // (RMS 6.9 m/s): the first at or above 5 m/s; the watch fires at the end of block 9, the 8th.
+  EXPECT_EQ(fired->window, 2 + 10 * kBlock - 1);
+  // A jolt at the same level lasting 7 blocks (the 2D closing's chatter grew for at most 7)
+  // passes, and so does the saturated mode with the rule off.
+  OscillationWatch jolt(0.5, 12, 5.0, 8);
+  EXPECT_FALSE(feed(jolt, 100 * kBlock, [](int n) {
+    return (n >= 2 && n < 2 + 7 * kBlock ? 6.0 : 0.0) * std::cos(std::numbers::pi * n / 2.0);
+  }));
+  OscillationWatch off(0.5, 12, 0.0, 8);
+  EXPECT_FALSE(feed(off, 100 * kBlock, saturated));
 }
 
 }  // namespace

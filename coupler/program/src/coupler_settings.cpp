@@ -62,6 +62,8 @@ CouplerSettings settings_from_case(const cases::Case& run_case, const std::files
   settings.max_interface_speed = coupling.max_interface_speed();
   settings.runaway_oscillation_speed = coupling.runaway_oscillation_speed();
   settings.runaway_growing_blocks = coupling.runaway_growing_blocks();
+  settings.runaway_standing_speed = coupling.runaway_standing_speed();
+  settings.runaway_standing_blocks = coupling.runaway_standing_blocks();
   settings.explicit_motion_previous_window_mean =
       coupling.explicit_motion_velocity() == cases::CouplingCase::PREVIOUS_WINDOW_MEAN;
   return settings;

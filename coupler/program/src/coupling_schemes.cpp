@@ -171,6 +171,19 @@ void check_window(const WindowRecord& record, const WindowSpan& window, const So
           settings.max_interface_speed, cause(node)));
     }
   }
+  if (const auto& alarm = watch.alarm(); alarm && alarm->standing) {
+    const Eigen::Vector3d where = 1e3 * solid.positions.col(alarm->node);
+    const double speed = solid.velocities.col(alarm->node).norm();
+    throw coupling::CouplingFailed(fmt::format(
+        "window {} (t = {} s to {} s): solid interface node {} at ({:.3f}, {:.3f}, {:.3f}) mm (now at {:.3g} m/s) jumps "
+        "in velocity from window to window by {:.3g} m/s RMS over the last {} windows, and every one of the last {} "
+        "blocks of {} windows stood at or above coupling.runaway_standing_speed = {} m/s ({:.3g} m/s {} blocks ago): "
+        "the interface oscillates at the window's scale and does not settle. {}; raise runaway_standing_speed or "
+        "runaway_standing_blocks only if the leaflet really moves on the window's time scale",
+        window.index, window.time, window.time + window.size, alarm->node, where.x(), where.y(), where.z(), speed,
+        alarm->oscillation, alarm->block_windows, alarm->blocks, alarm->block_windows, settings.runaway_standing_speed,
+        alarm->oscillation_before, alarm->blocks, cause(alarm->node)));
+  }
   if (const auto& alarm = watch.alarm()) {
     const Eigen::Vector3d where = 1e3 * solid.positions.col(alarm->node);
     const double speed = solid.velocities.col(alarm->node).norm();
@@ -210,7 +223,8 @@ SchemeSummary run_coupling_scheme(WindowExchange& exchange, const CouplerSetting
   if (settings.scheme == SchemeKind::serial_implicit) acceleration = coupling::make_acceleration(settings.acceleration);
 
   // A restart starts it afresh: it needs two windows of velocities and then whole blocks.
-  OscillationWatch watch(settings.runaway_oscillation_speed, settings.runaway_growing_blocks);
+  OscillationWatch watch(settings.runaway_oscillation_speed, settings.runaway_growing_blocks,
+                         settings.runaway_standing_speed, settings.runaway_standing_blocks);
   InterfaceHistory history;
   SchemeSummary summary;
   Proposals proposals;

@@ -40,6 +40,8 @@ struct CouplerSettings {
   double max_interface_speed = 20.0;  // m/s
   double runaway_oscillation_speed = 0.5;  // m/s
   int runaway_growing_blocks = 12;
+  double runaway_standing_speed = 0.0;  // m/s
+  int runaway_standing_blocks = 8;
   // Explicit schemes: the fluid's points move with the solid's mean velocity over the previous
   // window instead of its velocity at the window's start (coupling.explicit_motion_velocity).
   bool explicit_motion_previous_window_mean = false;

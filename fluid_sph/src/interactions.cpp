@@ -19,6 +19,10 @@ namespace {
 template <int D>
 struct PairConstants {
   float mass, rest_density, h, support2, two_mu, alpha_c0, eta2, diffusion, hydrostatic;
+  // A squared distance beyond which q = r/h rounds to at least 2 for certain (the support's
+  // 2h with a 1e-4 margin, far above the ~1e-7 rounding of sqrt and r/h): every pair term
+  // of both kernels is then an exact zero.
+  float surely_outside2;
   std::array<float, D> gravity;
   explicit PairConstants(const FluidSettings<D>& s)
       : mass(static_cast<float>(s.particle_mass())),
@@ -29,7 +33,8 @@ struct PairConstants {
         alpha_c0(static_cast<float>(s.artificial_viscosity * s.sound_speed)),
         eta2(static_cast<float>(0.01 * s.smoothing_length() * s.smoothing_length())),
         diffusion(static_cast<float>(2.0 * s.density_diffusion * s.smoothing_length() * s.sound_speed)),
-        hydrostatic(static_cast<float>(s.rest_density / (s.sound_speed * s.sound_speed))) {
+        hydrostatic(static_cast<float>(s.rest_density / (s.sound_speed * s.sound_speed))),
+        surely_outside2(static_cast<float>(s.support_radius() * s.support_radius() * (1.0 + 1e-4))) {
     for (int d = 0; d < D; ++d) gravity[d] = static_cast<float>(s.gravity[d]);
   }
 };
@@ -337,6 +342,10 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Viscous,
   source([&](const Neighbour& b) {
     for (int c = 0; c < C; ++c) {
       const auto [dx, dy, dz, r2] = lane_offset<D>(x, c, b.x, b.y, b.z);
+      // A neighbour beyond the support of every lane of this vector adds exact zeros (the
+      // sums start at +0 and never become -0, so adding +-0 leaves every bit): skipped.
+      if constexpr (C > 1)
+        if (xsimd::none(r2 < B(k.surely_outside2))) continue;
       const B r = xsimd::sqrt(r2);
       const B F = gradient_factor(W, r);
       const B inv_rr = inv[c] * b.inv;

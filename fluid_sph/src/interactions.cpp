@@ -647,8 +647,9 @@ struct WallNeighbour {
 
 // The wall state's sums for a whole list of fluid neighbours, the lanes' sums in registers
 // (C vectors of lanes) for the length of the list, as sweep_neighbours does for the rates.
+// surely_outside2: as PairConstants' (a vector of lanes all beyond it gets exact zeros).
 template <int D, int C, class Kernel>
-inline void sweep_wall_neighbours(WallLanes& L, const WallNeighbour* nb, std::size_t count, const Kernel& W) {
+inline void sweep_wall_neighbours(WallLanes& L, const WallNeighbour* nb, std::size_t count, const Kernel& W, float surely_outside2) {
   using B = LaneBatch;
   constexpr int S = kBatch;
   B x[3][C], sum_w[C], sum_p[C], sum_rho_r[3][C], sum_v[3][C];
@@ -663,6 +664,8 @@ inline void sweep_wall_neighbours(WallLanes& L, const WallNeighbour* nb, std::si
     const WallNeighbour& b = nb[j];
     for (int c = 0; c < C; ++c) {
       const auto [dx, dy, dz, r2] = lane_offset<D>(x, c, b.x, b.y, b.z);
+      if constexpr (C > 1)
+        if (xsimd::none(r2 < B(surely_outside2))) continue;
       const B wk = kernel_value(W, xsimd::sqrt(r2));
       sum_w[c] += wk;
       sum_p[c] += b.p * wk;
@@ -687,11 +690,12 @@ inline void sweep_wall_neighbours(WallLanes& L, const WallNeighbour* nb, std::si
 }
 
 template <int D, int C = kBlock / kBatch, class Kernel>
-inline void sweep_wall_lanes(int n, WallLanes& L, const WallNeighbour* list, std::size_t count, const Kernel& W) {
+inline void sweep_wall_lanes(int n, WallLanes& L, const WallNeighbour* list, std::size_t count, const Kernel& W,
+                             float surely_outside2) {
   if constexpr (C > 1) {
-    if (n <= (C - 1) * kBatch) return sweep_wall_lanes<D, C - 1>(n, L, list, count, W);
+    if (n <= (C - 1) * kBatch) return sweep_wall_lanes<D, C - 1>(n, L, list, count, W, surely_outside2);
   }
-  sweep_wall_neighbours<D, C>(L, list, count, W);
+  sweep_wall_neighbours<D, C>(L, list, count, W, surely_outside2);
 }
 
 // Sums over the fluid neighbours of every wall lane of one cell (SIMD over the lanes, each
@@ -701,7 +705,8 @@ template <int D, bool Masked, class Kernel>
                                              const LinearMieGruneisen& eos, const Kernel& W, const std::uint32_t* lane_index,
                                              int n, const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments,
                                              int segment_count, const PairFilter<D>& filter,
-                                             const std::vector<Vec<D>>& body_acceleration, float support2, WallLanes& L,
+                                             const std::vector<Vec<D>>& body_acceleration, float support2,
+                                             float surely_outside2, WallLanes& L,
                                              std::vector<WallNeighbour>& list) {
   const float rho0 = static_cast<float>(s.rest_density);
   {
@@ -774,7 +779,7 @@ template <int D, bool Masked, class Kernel>
         }
       }
     }
-    if constexpr (!Masked) sweep_wall_lanes<D>(n, L, list.data(), listed, W);
+    if constexpr (!Masked) sweep_wall_lanes<D>(n, L, list.data(), listed, W, surely_outside2);
     for (int i = 0; i < n; ++i) {
       const std::uint32_t w = lane_index[i];
       if (particles.kind[w] != Kind::wall && particles.kind[w] != Kind::mirror_wall) continue;
@@ -832,6 +837,7 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
   const LinearMieGruneisen eos{s.rest_density, s.sound_speed};
   const ParticleView<D> view(p);
   const float support2 = static_cast<float>(s.support_radius() * s.support_radius());
+  const float surely_outside2 = PairConstants<D>(s).surely_outside2;
   std::fill(p.near_wall.begin(), p.near_wall.end(), std::uint8_t{0});
   with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
 #pragma omp parallel
@@ -842,9 +848,9 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
           grid, [&](std::uint32_t a) { return p.kind[a] == Kind::wall || p.kind[a] == Kind::mirror_wall; },
           [&](const std::uint32_t* lane_index, int n, const auto& segments, int count) {
             if (filter.touches(segments, count))
-              cell_block_wall_state<D, true>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, lanes, list);
+              cell_block_wall_state<D, true>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, surely_outside2, lanes, list);
             else
-              cell_block_wall_state<D, false>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, lanes, list);
+              cell_block_wall_state<D, false>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, surely_outside2, lanes, list);
           });
     }
   });

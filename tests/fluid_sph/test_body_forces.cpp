@@ -36,31 +36,8 @@ void expect_booked_equals_direct(const FluidSolver<D>& solver) {
       << "direct " << direct[0][0] << ", " << direct[0][1] << "; booked " << booked[0][0] << ", " << booked[0][1];
 }
 
-TEST(BodyForces, BookedInPairLoopEqualsWallPass3DWithMirrorPlane) {
-  auto tank = still_tank_3d(3000);
-  auto& s = tank.settings;
-  s.mirror_planes.push_back({{0.0, 0.5, 0.0}, {0.0, 1.0, 0.0}});  // fluid at y > 0.5
-  Particles<3> particles = fill_particles(tank.scene, s);
-  for (std::size_t i = 0; i < particles.size(); ++i) {
-    if (particles.kind[i] != Kind::fluid) continue;
-    const double x = particles.position[0][i], z = particles.position[2][i];
-    particles.velocity[0][i] = static_cast<float>(0.5 * std::sin(std::numbers::pi * z));
-    particles.velocity[2][i] = static_cast<float>(-0.5 * std::sin(0.5 * std::numbers::pi * x));
-    particles.viscous_velocity[0][i] = particles.velocity[0][i];
-    particles.viscous_velocity[2][i] = particles.velocity[2][i];
-  }
-  FluidSolver<3> solver(s, std::move(particles));
-  for (int k = 0; k < 5; ++k) solver.step();
-  ASSERT_GT(solver.particles().count(Kind::mirror_fluid), 0u);
-  expect_booked_equals_direct(solver);
-}
-
-// The vectorised pair loop leaves out neighbours by bounding boxes and skips a neighbour for a
-// vector of lanes all beyond its support (session 14). Neither may drop a pair within the
-// support: the continuity rate and the kernel sum of every fluid particle equal a brute-force
-// sum over all pairs (walls and mirror images included) in double precision, to float
-// round-off of the sum of the terms' magnitudes.
-TEST(BodyForces, PairLoopRatesEqualABruteForceSumOverAllPairs3D) {
+// The 3D tank with a mirror plane (fluid at y > 0.5) in a shear flow, after `steps` steps.
+FluidSolver<3> sheared_tank_with_mirror_plane(int steps) {
   auto tank = still_tank_3d(3000);
   auto& s = tank.settings;
   s.mirror_planes.push_back({{0.0, 0.5, 0.0}, {0.0, 1.0, 0.0}});
@@ -74,7 +51,24 @@ TEST(BodyForces, PairLoopRatesEqualABruteForceSumOverAllPairs3D) {
     particles.viscous_velocity[2][i] = particles.velocity[2][i];
   }
   FluidSolver<3> solver(s, std::move(particles));
-  for (int k = 0; k < 3; ++k) solver.step();
+  for (int k = 0; k < steps; ++k) solver.step();
+  return solver;
+}
+
+TEST(BodyForces, BookedInPairLoopEqualsWallPass3DWithMirrorPlane) {
+  const FluidSolver<3> solver = sheared_tank_with_mirror_plane(5);
+  ASSERT_GT(solver.particles().count(Kind::mirror_fluid), 0u);
+  expect_booked_equals_direct(solver);
+}
+
+// The vectorised pair loop leaves out neighbours by bounding boxes and skips a neighbour for a
+// vector of lanes all beyond its support (session 14). Neither may drop a pair within the
+// support: the continuity rate and the kernel sum of every fluid particle equal a brute-force
+// sum over all pairs (walls and mirror images included) in double precision, to float
+// round-off of the sum of the terms' magnitudes.
+TEST(BodyForces, PairLoopRatesEqualABruteForceSumOverAllPairs3D) {
+  const FluidSolver<3> solver = sheared_tank_with_mirror_plane(3);
+  ASSERT_GT(solver.particles().count(Kind::mirror_fluid), 0u);
   Particles<3> p = solver.particles();
   auto settings = solver.settings();
   settings.density_diffusion = 0.0;  // density rate = continuity alone

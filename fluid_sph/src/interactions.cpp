@@ -19,6 +19,10 @@ namespace {
 template <int D>
 struct PairConstants {
   float mass, rest_density, h, support2, two_mu, alpha_c0, eta2, diffusion, hydrostatic;
+  // A squared distance beyond which q = r/h rounds to at least 2 for certain (the support's
+  // 2h with a 1e-4 margin, far above the ~1e-7 rounding of sqrt and r/h): every pair term
+  // of both kernels is then an exact zero.
+  float surely_outside2;
   std::array<float, D> gravity;
   explicit PairConstants(const FluidSettings<D>& s)
       : mass(static_cast<float>(s.particle_mass())),
@@ -29,7 +33,8 @@ struct PairConstants {
         alpha_c0(static_cast<float>(s.artificial_viscosity * s.sound_speed)),
         eta2(static_cast<float>(0.01 * s.smoothing_length() * s.smoothing_length())),
         diffusion(static_cast<float>(2.0 * s.density_diffusion * s.smoothing_length() * s.sound_speed)),
-        hydrostatic(static_cast<float>(s.rest_density / (s.sound_speed * s.sound_speed))) {
+        hydrostatic(static_cast<float>(s.rest_density / (s.sound_speed * s.sound_speed))),
+        surely_outside2(static_cast<float>(s.support_radius() * s.support_radius() * (1.0 + 1e-4))) {
     for (int d = 0; d < D; ++d) gravity[d] = static_cast<float>(s.gravity[d]);
   }
 };
@@ -291,6 +296,8 @@ inline LaneBatch kernel_value(const CubicSplineKernel<D>& W, const LaneBatch& r)
 struct NeighbourLists {
   std::vector<Neighbour> plain;
   std::array<std::vector<Neighbour>, kMaxBookedBodies> booked;
+  std::vector<std::uint32_t> kept;  // one segment's candidates that pass the box test
+  std::vector<std::uint8_t> near;   // the box test of each of one segment's candidates
   std::size_t plain_count = 0;
   std::array<std::size_t, kMaxBookedBodies> booked_count{};
   void make_room(std::size_t candidates, bool with_bodies) {
@@ -335,6 +342,10 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Viscous,
   source([&](const Neighbour& b) {
     for (int c = 0; c < C; ++c) {
       const auto [dx, dy, dz, r2] = lane_offset<D>(x, c, b.x, b.y, b.z);
+      // A neighbour beyond the support of every lane of this vector adds exact zeros (the
+      // sums start at +0 and never become -0, so adding +-0 leaves every bit): skipped.
+      if constexpr (C > 1)
+        if (xsimd::none(r2 < B(k.surely_outside2))) continue;
       const B r = xsimd::sqrt(r2);
       const B F = gradient_factor(W, r);
       const B inv_rr = inv[c] * b.inv;
@@ -490,10 +501,32 @@ template <int D, bool WithArtificialViscosity, bool WithKernelSum, bool Masked, 
         const auto& seg = segments[sidx];
         float shift[3] = {0, 0, 0};
         for (int d = 0; d < D; ++d) shift[d] = static_cast<float>(seg.shift[d]);
-        for (std::uint32_t b = seg.begin; b < seg.end; ++b) {
-          const float y = p.x[1][b] + shift[1], z = D == 3 ? p.x[D - 1][b] + shift[2] : 0.0f;
-          if (near_box<D>(box_lo, box_hi, p.x[0][b] + shift[0], y, z, k.support2)) take(b, neighbour(b, shift));
+        // The box test keeps about half of the candidates in no predictable pattern: as a
+        // branch it mispredicts half the time. So the segment is tested in one vector pass,
+        // and the kept indices are compacted without a branch (each index is written, the
+        // count grows by the test's 0 or 1).
+        const std::uint32_t length = seg.end - seg.begin;
+        if (lists.kept.size() < length) {
+          lists.kept.resize(length);
+          lists.near.resize(length);
         }
+        std::uint32_t* kept = lists.kept.data();
+        std::uint8_t* near = lists.near.data();
+        const float* x0 = p.x[0];
+        const float* x1 = p.x[1];
+        const float* x2 = p.x[D - 1];
+#pragma omp simd
+        for (std::uint32_t j = 0; j < length; ++j) {
+          const std::uint32_t b = seg.begin + j;
+          const float y = x1[b] + shift[1], z = D == 3 ? x2[b] + shift[2] : 0.0f;
+          near[j] = near_box<D>(box_lo, box_hi, x0[b] + shift[0], y, z, k.support2) ? 1 : 0;
+        }
+        std::size_t kept_count = 0;
+        for (std::uint32_t j = 0; j < length; ++j) {
+          kept[kept_count] = seg.begin + j;
+          kept_count += near[j];
+        }
+        for (std::size_t j = 0; j < kept_count; ++j) take(kept[j], neighbour(kept[j], shift));
       }
     };
     auto sweep = [&](const auto& source, float (*acc)[kBlock]) {
@@ -614,8 +647,9 @@ struct WallNeighbour {
 
 // The wall state's sums for a whole list of fluid neighbours, the lanes' sums in registers
 // (C vectors of lanes) for the length of the list, as sweep_neighbours does for the rates.
+// surely_outside2: as PairConstants' (a vector of lanes all beyond it gets exact zeros).
 template <int D, int C, class Kernel>
-inline void sweep_wall_neighbours(WallLanes& L, const WallNeighbour* nb, std::size_t count, const Kernel& W) {
+inline void sweep_wall_neighbours(WallLanes& L, const WallNeighbour* nb, std::size_t count, const Kernel& W, float surely_outside2) {
   using B = LaneBatch;
   constexpr int S = kBatch;
   B x[3][C], sum_w[C], sum_p[C], sum_rho_r[3][C], sum_v[3][C];
@@ -630,6 +664,8 @@ inline void sweep_wall_neighbours(WallLanes& L, const WallNeighbour* nb, std::si
     const WallNeighbour& b = nb[j];
     for (int c = 0; c < C; ++c) {
       const auto [dx, dy, dz, r2] = lane_offset<D>(x, c, b.x, b.y, b.z);
+      if constexpr (C > 1)
+        if (xsimd::none(r2 < B(surely_outside2))) continue;
       const B wk = kernel_value(W, xsimd::sqrt(r2));
       sum_w[c] += wk;
       sum_p[c] += b.p * wk;
@@ -654,11 +690,12 @@ inline void sweep_wall_neighbours(WallLanes& L, const WallNeighbour* nb, std::si
 }
 
 template <int D, int C = kBlock / kBatch, class Kernel>
-inline void sweep_wall_lanes(int n, WallLanes& L, const WallNeighbour* list, std::size_t count, const Kernel& W) {
+inline void sweep_wall_lanes(int n, WallLanes& L, const WallNeighbour* list, std::size_t count, const Kernel& W,
+                             float surely_outside2) {
   if constexpr (C > 1) {
-    if (n <= (C - 1) * kBatch) return sweep_wall_lanes<D, C - 1>(n, L, list, count, W);
+    if (n <= (C - 1) * kBatch) return sweep_wall_lanes<D, C - 1>(n, L, list, count, W, surely_outside2);
   }
-  sweep_wall_neighbours<D, C>(L, list, count, W);
+  sweep_wall_neighbours<D, C>(L, list, count, W, surely_outside2);
 }
 
 // Sums over the fluid neighbours of every wall lane of one cell (SIMD over the lanes, each
@@ -668,7 +705,8 @@ template <int D, bool Masked, class Kernel>
                                              const LinearMieGruneisen& eos, const Kernel& W, const std::uint32_t* lane_index,
                                              int n, const std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)>& segments,
                                              int segment_count, const PairFilter<D>& filter,
-                                             const std::vector<Vec<D>>& body_acceleration, float support2, WallLanes& L,
+                                             const std::vector<Vec<D>>& body_acceleration, float support2,
+                                             float surely_outside2, WallLanes& L,
                                              std::vector<WallNeighbour>& list) {
   const float rho0 = static_cast<float>(s.rest_density);
   {
@@ -741,7 +779,7 @@ template <int D, bool Masked, class Kernel>
         }
       }
     }
-    if constexpr (!Masked) sweep_wall_lanes<D>(n, L, list.data(), listed, W);
+    if constexpr (!Masked) sweep_wall_lanes<D>(n, L, list.data(), listed, W, surely_outside2);
     for (int i = 0; i < n; ++i) {
       const std::uint32_t w = lane_index[i];
       if (particles.kind[w] != Kind::wall && particles.kind[w] != Kind::mirror_wall) continue;
@@ -799,6 +837,7 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
   const LinearMieGruneisen eos{s.rest_density, s.sound_speed};
   const ParticleView<D> view(p);
   const float support2 = static_cast<float>(s.support_radius() * s.support_radius());
+  const float surely_outside2 = PairConstants<D>(s).surely_outside2;
   std::fill(p.near_wall.begin(), p.near_wall.end(), std::uint8_t{0});
   with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
 #pragma omp parallel
@@ -809,9 +848,9 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
           grid, [&](std::uint32_t a) { return p.kind[a] == Kind::wall || p.kind[a] == Kind::mirror_wall; },
           [&](const std::uint32_t* lane_index, int n, const auto& segments, int count) {
             if (filter.touches(segments, count))
-              cell_block_wall_state<D, true>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, lanes, list);
+              cell_block_wall_state<D, true>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, surely_outside2, lanes, list);
             else
-              cell_block_wall_state<D, false>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, lanes, list);
+              cell_block_wall_state<D, false>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, surely_outside2, lanes, list);
           });
     }
   });

@@ -76,6 +76,12 @@ HexahedronSolver& SolidSetup::hexahedron_solver() const {
 
 namespace {
 
+// solid.implicit_tangent_cost when unset: off. At the measured price (a tangent ~20 explicit
+// steps) the rule made the coarse sector's cycle slower (its closed leaflet's implicit phases
+// are expensive until they have damped the ringing, which the explicit phases do not) and the
+// full valve's 200-270 ms no cheaper than explicit (docs/solid_fe.md, "Fourteenth session").
+constexpr double kDefaultImplicitTangentCost = 0.0;
+
 const std::vector<std::int64_t>& node_set(const Mesh& mesh, const std::string& name, const std::string& field,
                                           const std::string& source, const std::string& mesh_file) {
   const auto it = mesh.node_sets.find(name);
@@ -175,6 +181,12 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.max_energy_balance_error = solid.max_energy_balance_error();
   solver_options.fixed_time_step = solid.forced_time_step();
   solver_options.time_step_look_ahead = solid.time_step_look_ahead();
+  if (solid.has_implicit_tangent_cost() && solid.time_integration() != cases::SolidCase::AUTOMATIC) {
+    throw CaseError(fmt::format("{}: field 'solid.implicit_tangent_cost' = {} with solid.time_integration = {}: "
+                                "it prices the automatic switch's implicit steps; allowed only with "
+                                "time_integration AUTOMATIC (>= 0; 0 turns the cost rule off)",
+                                source, solid.implicit_tangent_cost(), integration));
+  }
   if (solid.settled_filter_time_s() > 0.0 && solid.time_integration() != cases::SolidCase::AUTOMATIC) {
     throw CaseError(fmt::format("{}: field 'solid.settled_filter_time_s' = {} with solid.time_integration = {}: "
                                 "it filters the automatic switch's kinetic energy; allowed > 0 only with "
@@ -198,6 +210,10 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
     solver_options.settled_hold = solid.settled_hold_s();
     solver_options.moving_kinetic_ratio = solid.moving_kinetic_ratio();
     solver_options.settled_filter_time = solid.settled_filter_time_s();
+    if (solid.time_integration() == cases::SolidCase::AUTOMATIC) {
+      solver_options.implicit_tangent_cost =
+          solid.has_implicit_tangent_cost() ? solid.implicit_tangent_cost() : kDefaultImplicitTangentCost;
+    }
     if (solver_options.settled_filter_time > 0.0) {
       setup.notes.push_back(fmt::format(
           "automatic switch on the kinetic energy low-pass filtered over {} s (solid.settled_filter_time_s){}",

@@ -600,6 +600,7 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
       state_.implicit_switch_pressure = pressure_ ? pressure_(state_.time) : 0.0;
       state_.chatter_damped = false;
       ++state_.switches;
+      start_cost_rule();
       drop_kept_tangent();
     }
   }

@@ -37,6 +37,9 @@ struct ExplicitSolver::ImplicitWork {
   bool factor_valid = false;
   double factor_step = 0;
   int fast_steps = 0;  // consecutive steps converged within newton_fast_iterations
+  // Cost rule: work since the last accepted step (failed tries included) in explicit-step
+  // equivalents; moved into SolverState::block_work when a step is accepted.
+  double pending_work = 0;
   Eigen::Matrix3Xd dx, a, v, r, net, net_n;
   Eigen::VectorXd delta;
 };
@@ -122,6 +125,7 @@ bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_force
   for (int iteration = 0;; ++iteration) {
     state_.position = x_n + w.dx;
     state_.time = t_new;
+    w.pending_work += 1.0;  // one force evaluation, as an explicit step
     try {
       compute_internal_force(false);
       compute_contact_force();
@@ -177,6 +181,7 @@ bool ExplicitSolver::factorise_tangent(double h, double t_new, double mass_coeff
   const Eigen::ArrayXd mass = elements_->nodal_mass().array();
   const Eigen::Index n = state_.position.cols();
   w.factor_valid = false;
+  w.pending_work += options_.implicit_tangent_cost;
   {
     // Tangent: mass_coefficient M + (1 - alpha_f) (K_int - K_pressure + K_contact), constrained
     // rows and columns projected, their diagonal kept at the mass term so the matrix stays regular.
@@ -273,6 +278,35 @@ bool ExplicitSolver::finish_implicit_step(const SolverState& start, double h) {
   return true;
 }
 
+bool ExplicitSolver::implicit_costs_more() {
+  ImplicitWork& w = *implicit_;
+  state_.block_work += w.pending_work;
+  w.pending_work = 0.0;
+  if (++state_.phase_steps % kCostRuleSteps != 0) return false;
+  // The block's work against the explicit steps its time would have taken; the first block is
+  // the step's ramp from implicit_initial_step, paid once per phase, and is not judged. A block
+  // whose step grew is not judged either: the scheme is still damping what the explicit phase
+  // left (the closed sector rings at 6-25 us steps for ~10 ms, then takes 0.1 ms steps; going
+  // back to explicit there keeps the ringing and the next try starts over).
+  const double explicit_steps =
+      state_.explicit_step_at_switch > 0.0 ? (state_.time - state_.block_start) / state_.explicit_step_at_switch : 0.0;
+  const bool costs_more = state_.phase_steps > kCostRuleSteps && state_.explicit_step_at_switch > 0.0 &&
+                          state_.implicit_step <= state_.block_start_step && state_.block_work > explicit_steps;
+  state_.block_work = 0.0;
+  state_.block_start = state_.time;
+  state_.block_start_step = state_.implicit_step;
+  return costs_more;
+}
+
+void ExplicitSolver::start_cost_rule() {
+  state_.explicit_step_at_switch = state_.uncut_step;
+  state_.phase_steps = 0;
+  state_.block_work = 0.0;
+  state_.block_start = state_.time;
+  state_.block_start_step = 0.0;
+  if (implicit_) implicit_->pending_work = 0.0;
+}
+
 void ExplicitSolver::drop_kept_tangent() {
   if (!implicit_) return;
   implicit_->factor_valid = false;
@@ -336,6 +370,11 @@ void ExplicitSolver::advance_window_implicit(double t_end, const Eigen::Matrix3X
       if (options_.max_energy_balance_error > 0.0 && state_.step >= kEnergyCheckFirstStep) check_energy_growth();
       if (automatic()) update_slow_velocity(step);
       if (automatic() && moving_again()) {
+        switch_to_explicit();
+        return;
+      }
+      if (automatic() && options_.implicit_tangent_cost > 0.0 && implicit_costs_more()) {
+        ++state_.cost_switches;
         switch_to_explicit();
         return;
       }

@@ -138,7 +138,11 @@ void SeriesWriter::sample(const ExplicitSolver& solver, double pressure_Pa) {
   columns_["implicit"].push_back(solver.implicit() ? 1.0 : 0.0);
   columns_["newton_iterations"].push_back(static_cast<double>(s.newton_iterations));
   columns_["cpu_time_s"].push_back(static_cast<double>(std::clock()) / CLOCKS_PER_SEC);
-  if (solver.automatic()) columns_["energy/slow_kinetic"].push_back(s.slow_kinetic);
+  if (solver.automatic()) {
+    columns_["energy/slow_kinetic"].push_back(s.slow_kinetic);
+    columns_["switches"].push_back(static_cast<double>(s.switches));
+    columns_["cost_switches"].push_back(static_cast<double>(s.cost_switches));
+  }
   // Where the step comes from: the dt last used (growth limit and contact included), the element
   // that bounds it, the factor the calibration applies to the element bound, and the factor the
   // Lanczos step alone (2 / omega_max) would allow at the last calibration.

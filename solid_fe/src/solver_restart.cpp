@@ -110,6 +110,10 @@ void write_solver_restart(const ExplicitSolver& solver, coupling::RestartWriter&
   put_matrix(file, "solid/slow_velocity", s.slow_velocity);
   file.put("solid/slow_kinetic", s.slow_kinetic);
   file.put_integer("solid/chatter_damped", s.chatter_damped ? 1 : 0);
+  // The cost rule's books (fourteenth session).
+  const double books[] = {s.explicit_step_at_switch, s.block_work, s.block_start, s.block_start_step,
+                          static_cast<double>(s.phase_steps), static_cast<double>(s.cost_switches)};
+  file.put("solid/cost_rule/books", std::span<const double>(books));
 }
 
 void write_solver_restart(const ExplicitSolver& solver, const std::filesystem::path& file) {
@@ -184,6 +188,17 @@ void read_solver_restart(const coupling::RestartReader& file, ExplicitSolver& so
     s.slow_velocity = get_nodes(file, "solid/slow_velocity", n, true);
     s.slow_kinetic = file.scalar("solid/slow_kinetic");
     s.chatter_damped = file.integer("solid/chatter_damped") != 0;
+  }
+  // (files before the fourteenth session: no cost rule's books; an implicit phase in progress
+  // is then not judged, the next one is)
+  if (file.has("solid/cost_rule/books")) {
+    const auto books = file.doubles("solid/cost_rule/books", 6);
+    s.explicit_step_at_switch = books[0];
+    s.block_work = books[1];
+    s.block_start = books[2];
+    s.block_start_step = books[3];
+    s.phase_steps = static_cast<std::int64_t>(books[4]);  // (counts, exact in a double)
+    s.cost_switches = static_cast<std::int64_t>(books[5]);
   }
   const auto pairs = file.integers("solid/contact_candidates/pairs");
   s.contact_candidates.pairs.clear();

@@ -34,7 +34,8 @@ double pressure(double t) {
 
 std::unique_ptr<ShellSolver> flap(TimeIntegration integration,
                                   double settled_filter_time = SolverOptions{}.settled_filter_time,
-                                  double time_step_safety = SolverOptions{}.time_step_safety) {
+                                  double time_step_safety = SolverOptions{}.time_step_safety,
+                                  double implicit_tangent_cost = 0.0, double max_time_step = 1e-3) {
   Mesh mesh = rectangular_plate(0.01, 0.005, 10, 5, kThickness);
   ShellModelOptions options;
   options.fixed_nodes = mesh.node_sets.at("left");
@@ -42,7 +43,8 @@ std::unique_ptr<ShellSolver> flap(TimeIntegration integration,
   o.max_energy_balance_error = 0.2;
   o.time_integration = integration;
   o.implicit_initial_step = 1e-6;
-  o.max_time_step = 1e-3;
+  o.max_time_step = max_time_step;
+  o.implicit_tangent_cost = implicit_tangent_cost;
   o.settled_filter_time = settled_filter_time;
   o.time_step_safety = time_step_safety;
   auto solver = std::make_unique<ShellSolver>(build_shell_model(mesh, options), Material{Mhgo{}}, o);
@@ -55,16 +57,20 @@ struct FlapRun {
   Eigen::Matrix3Xd pressed, released;  // positions at kRelease and kEnd
   std::vector<std::int64_t> steps_at_ms;       // steps taken by the end of each 1 ms window
   std::vector<double> switch_times;    // AUTOMATIC: the times its phase changed
+  std::int64_t cost_switches = 0;      // AUTOMATIC: back to explicit by the cost rule
+  std::int64_t implicit_steps = 0;     // AUTOMATIC: steps taken in the implicit phase
 };
 
 FlapRun run_flap(TimeIntegration integration, double settled_filter_time = SolverOptions{}.settled_filter_time,
-                 double time_step_safety = SolverOptions{}.time_step_safety) {
-  auto solver = flap(integration, settled_filter_time, time_step_safety);
+                 double time_step_safety = SolverOptions{}.time_step_safety, double implicit_tangent_cost = 0.0,
+                 double max_time_step = 1e-3) {
+  auto solver = flap(integration, settled_filter_time, time_step_safety, implicit_tangent_cost, max_time_step);
   FlapRun r;
   bool phase = false;
   solver->set_step_observer([&](const SolverState& s) {
     if (s.implicit_phase != phase) r.switch_times.push_back(s.time);
     phase = s.implicit_phase;
+    if (s.implicit_phase) ++r.implicit_steps;
   });
   for (int k = 1; k <= kWindows; ++k) {
     solver->advance_window(k * 1e-3);
@@ -72,6 +78,7 @@ FlapRun run_flap(TimeIntegration integration, double settled_filter_time = Solve
     if (k == 60) r.pressed = solver->state().position;
   }
   r.released = solver->state().position;
+  r.cost_switches = solver->state().cost_switches;
   std::printf("%s: %lld steps, %lld switches, balance %.3g of the largest energy, numerical dissipation %.3g J\n",
               integration == TimeIntegration::automatic ? "automatic" : "explicit",
               static_cast<long long>(solver->state().step), static_cast<long long>(solver->state().switches),
@@ -157,6 +164,56 @@ TEST(AutomaticSwitch, FilteredKineticEnergySwitchesEarlierWithTheSameAnswer) {
   EXPECT_LT(released, 0.01 * kThickness);
   EXPECT_LT(released_instantaneous, 0.01 * kThickness);
   EXPECT_LT(filtered.steps_at_ms.back(), instantaneous.steps_at_ms.back());
+}
+
+// The cost rule (implicit_tangent_cost): an implicit phase whose block of 16 steps costs more
+// force evaluations and tangents than the explicit steps over the same time, and whose step did
+// not grow, goes back to explicit. Priced at 1 explicit step per tangent, same cost, two cases.
+// Large implicit steps (the pressed flap with the instantaneous switch, implicit from 27 ms): the
+// rule may send a block that still chatters back (measured 27.7 and 35.1 ms), but once the flap
+// lies still its large steps pay and the last implicit phase runs to the release (measured
+// 40.2-60.1 ms). Tiny ones (the flap with the 1 ms filter and every step capped at 8 us, so an
+// implicit step is no longer than an explicit one and costs at least two force evaluations): each
+// try ends after the ramp block and one judged block (measured 10 tries, 322 implicit steps
+// against 6,200 unpriced), and the run keeps the explicit run's answer.
+double longest_implicit_phase(const FlapRun& r, double end) {
+  double longest = 0.0;
+  for (std::size_t k = 0; k < r.switch_times.size(); k += 2) {
+    const double until = k + 1 < r.switch_times.size() ? r.switch_times[k + 1] : end;
+    longest = std::max(longest, until - r.switch_times[k]);
+  }
+  return longest;
+}
+
+TEST(AutomaticSwitch, CostRuleKeepsLargeImplicitStepsAndRefusesTinyOnes) {
+  constexpr double kCost = 1.0;
+  const FlapRun large = run_flap(TimeIntegration::automatic, 0.0, SolverOptions{}.time_step_safety, kCost);
+  const FlapRun large_reference = run_flap(TimeIntegration::explicit_central_difference);
+  for (double t : large.switch_times) std::printf("  large steps, priced: switch at %.4f ms\n", 1e3 * t);
+  const double large_released = (large.released - large_reference.released).colwise().norm().maxCoeff();
+  std::printf("large steps: cost switches %lld, longest implicit phase %.2f ms, released vs explicit %.3g m\n",
+              static_cast<long long>(large.cost_switches), 1e3 * longest_implicit_phase(large, kEnd), large_released);
+  ASSERT_GE(large.switch_times.size(), 2u);
+  EXPECT_GE(large.switch_times.back(), kRelease);  // the last phase ends at the release, not by the rule
+  EXPECT_GT(longest_implicit_phase(large, kEnd), 15e-3);
+  EXPECT_LT(large_released, 0.02 * kThickness);
+
+  constexpr double kTinyStep = 8e-6;
+  const FlapRun tiny_plain = run_flap(TimeIntegration::automatic, 1e-3, SolverOptions{}.time_step_safety, 0.0, kTinyStep);
+  const FlapRun tiny = run_flap(TimeIntegration::automatic, 1e-3, SolverOptions{}.time_step_safety, kCost, kTinyStep);
+  const FlapRun reference = run_flap(TimeIntegration::explicit_central_difference, 0.0, SolverOptions{}.time_step_safety,
+                                     0.0, kTinyStep);
+  const double released = (tiny.released - reference.released).colwise().norm().maxCoeff();
+  std::printf("tiny steps: cost switches %lld, longest implicit phase %.3f ms (unpriced %.2f ms), implicit steps %lld "
+              "(unpriced %lld), released vs explicit %.3g m\n", static_cast<long long>(tiny.cost_switches),
+              1e3 * longest_implicit_phase(tiny, kEnd), 1e3 * longest_implicit_phase(tiny_plain, kEnd),
+              static_cast<long long>(tiny.implicit_steps), static_cast<long long>(tiny_plain.implicit_steps), released);
+  EXPECT_EQ(tiny_plain.cost_switches, 0);
+  EXPECT_GE(tiny.cost_switches, 2);
+  EXPECT_LT(longest_implicit_phase(tiny, kEnd), 1e-3);
+  EXPECT_GT(longest_implicit_phase(tiny_plain, kEnd), 15e-3);
+  EXPECT_LT(tiny.implicit_steps, tiny_plain.implicit_steps / 4);
+  EXPECT_LT(released, 0.02 * kThickness);
 }
 
 // With the instantaneous and with the filtered switch: a restart written before the first switch

@@ -88,6 +88,29 @@ TEST(CaseSetup, AutomaticSwitchIsReadWithItsThresholdsAndRefusedWhenTheyCross) {
   }
 }
 
+// An AUTOMATIC-only field: set to `value` with EXPLICIT or IMPLICIT it is refused naming the file,
+// the field and its value, the integration and what is allowed; set to `out_of_limits` with
+// AUTOMATIC the loader refuses it naming the field.
+void expect_automatic_only(const std::string& field, const std::string& value, const std::string& out_of_limits) {
+  for (const std::string integration : {"EXPLICIT", "IMPLICIT", "AUTOMATIC"}) {
+    const std::string given = integration == "AUTOMATIC" ? out_of_limits : value;
+    const CaseFiles refused =
+        write_case(field + "_" + integration, "time_integration: " + integration + " " + field + ": " + given);
+    try {
+      setup_from_case(load_case(refused.case_file), refused.case_file);
+      ADD_FAILURE() << field << ": " << given << " with " << integration << " must be refused";
+    } catch (const CaseError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(field), std::string::npos) << what;
+      if (integration == "AUTOMATIC") continue;
+      EXPECT_NE(what.find(refused.case_file.string()), std::string::npos) << "names the file: " << what;
+      EXPECT_NE(what.find("solid." + field + "' = " + value), std::string::npos) << what;
+      EXPECT_NE(what.find(integration), std::string::npos) << what;
+      EXPECT_NE(what.find("only with time_integration AUTOMATIC"), std::string::npos) << "what is allowed: " << what;
+    }
+  }
+}
+
 TEST(CaseSetup, SettledFilterTimeIsReadForAutomaticAndRefusedWithoutIt) {
   const CaseFiles f = write_case("filter", "time_integration: AUTOMATIC settled_filter_time_s: 0.001 "
                                            "spectral_radius_infinity: 0.5");
@@ -96,29 +119,21 @@ TEST(CaseSetup, SettledFilterTimeIsReadForAutomaticAndRefusedWithoutIt) {
   EXPECT_EQ(setup_from_case(load_case(unset.case_file), unset.case_file).shell_solver().options().settled_filter_time,
             0.0)
       << "off unless asked for: the instantaneous switch is the default";
-  // Explicit and implicit runs have no switch to filter.
-  for (const std::string integration : {"EXPLICIT", "IMPLICIT"}) {
-    const CaseFiles refused = write_case("filter_" + integration,
-                                         "time_integration: " + integration + " settled_filter_time_s: 0.002");
-    try {
-      setup_from_case(load_case(refused.case_file), refused.case_file);
-      FAIL() << "settled_filter_time_s with " << integration << " must be refused";
-    } catch (const CaseError& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find(refused.case_file.string()), std::string::npos) << "names the file: " << what;
-      EXPECT_NE(what.find("solid.settled_filter_time_s' = 0.002"), std::string::npos) << what;
-      EXPECT_NE(what.find(integration), std::string::npos) << what;
-      EXPECT_NE(what.find("only with time_integration AUTOMATIC"), std::string::npos) << "what is allowed: " << what;
-    }
-  }
-  // The field's limits: negative time constants are refused by the loader, naming the field.
-  const CaseFiles negative = write_case("filter_negative", "time_integration: AUTOMATIC settled_filter_time_s: -0.001");
-  try {
-    setup_from_case(load_case(negative.case_file), negative.case_file);
-    FAIL() << "a negative filter time must be refused";
-  } catch (const CaseError& e) {
-    EXPECT_NE(std::string(e.what()).find("settled_filter_time_s"), std::string::npos) << e.what();
-  }
+  // Explicit and implicit runs have no switch to filter; negative time constants are refused by
+  // the loader's limits.
+  expect_automatic_only("settled_filter_time_s", "0.002", "-0.001");
+}
+
+// The automatic switch's cost rule: read with AUTOMATIC, off when unset (measured slower on the
+// sector, docs/solid_fe.md "Fourteenth session"), refused with the other integrators (naming file,
+// field, value, integration and what is allowed) and below 0 by the field limits.
+TEST(CaseSetup, ImplicitTangentCostIsReadForAutomaticAndRefusedWithoutIt) {
+  const CaseFiles f = write_case("tangent_cost", "time_integration: AUTOMATIC implicit_tangent_cost: 20");
+  EXPECT_EQ(setup_from_case(load_case(f.case_file), f.case_file).shell_solver().options().implicit_tangent_cost, 20.0);
+  const CaseFiles unset = write_case("tangent_cost_unset", "time_integration: AUTOMATIC");
+  EXPECT_EQ(setup_from_case(load_case(unset.case_file), unset.case_file).shell_solver().options().implicit_tangent_cost,
+            0.0);
+  expect_automatic_only("implicit_tangent_cost", "30", "-1");
 }
 
 TEST(CaseSetup, LeafletSelfContactIsReadAndRefusedForBricks) {

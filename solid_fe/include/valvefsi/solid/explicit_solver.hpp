@@ -111,6 +111,17 @@ struct SolverState {
   Eigen::Matrix3Xd slow_velocity;
   double slow_kinetic = 0;
   bool chatter_damped = false;
+  // Automatic switch's cost rule (implicit_tangent_cost > 0): the explicit step when the implicit
+  // phase began (s; 0: unknown, the rule waits for the next switch); the implicit phase's steps,
+  // its current block's work in explicit-step equivalents, the block's start time and the step
+  // proposed then; how often
+  // the rule has sent the run back to explicit.
+  double explicit_step_at_switch = 0;
+  std::int64_t phase_steps = 0;
+  double block_work = 0;
+  double block_start = 0;
+  double block_start_step = 0;
+  std::int64_t cost_switches = 0;
 };
 
 struct SymmetryConstraint {
@@ -189,8 +200,20 @@ struct SolverOptions {
   // 45 s CPU); with 0.8 the implicit open phase it starts crawls at ~1-3 us steps.
   // Case field: solid.settled_filter_time_s.
   double settled_filter_time = 0;
+  // > 0: the automatic switch's cost rule, with this the cost of building and factorising the
+  // implicit tangent in explicit steps (a Newton iteration's force evaluation counts 1, as an
+  // explicit step). Each block of kCostRuleSteps implicit steps after the phase's first (the
+  // step's ramp from implicit_initial_step) books its work; when it exceeds the explicit steps
+  // the block's time would have taken at the phase's starting explicit step and the step did not
+  // grow over the block, the run goes back to explicit (the next switch to implicit waits for
+  // settled_hold again). 0: off. Case field
+  // solid.implicit_tangent_cost (docs/solid_fe.md, "Fourteenth session").
+  double implicit_tangent_cost = 0;
 };
 
+// Cost rule's block of implicit steps: the phase's first block is its step's ramp (doubling every
+// two fast steps from implicit_initial_step: 2^8-fold in 16 steps) and is not judged.
+inline constexpr std::int64_t kCostRuleSteps = 16;
 // The energy-growth check starts here: the first steps' balance is a ratio of round-off-sized
 // energies.
 inline constexpr std::int64_t kEnergyCheckFirstStep = 100;
@@ -301,6 +324,11 @@ class ExplicitSolver {
   bool factorise_tangent(double h, double t_new, double mass_coefficient, double stiffness_coefficient);
   // Books a converged step from `start` (velocity, acceleration, energies).
   bool finish_implicit_step(const SolverState& start, double h);
+  // Automatic switch's cost rule (options_.implicit_tangent_cost): books an accepted implicit
+  // step's work and says, at the end of a block, whether explicit steps would have been cheaper;
+  // start_cost_rule begins a phase's books at the switch to implicit.
+  bool implicit_costs_more();
+  void start_cost_rule();
   // Automatic switch: the tests after an explicit step (to implicit) and an implicit one (back).
   bool settled_for_implicit();
   // After a step of h: low-pass filters the velocity (settled_filter_time > 0).

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "valvefsi/coupler/oscillation_watch.hpp"
 #include "valvefsi/coupler/restart_points.hpp"
@@ -171,31 +172,29 @@ void check_window(const WindowRecord& record, const WindowSpan& window, const So
           settings.max_interface_speed, cause(node)));
     }
   }
-  if (const auto& alarm = watch.alarm(); alarm && alarm->standing) {
-    const Eigen::Vector3d where = 1e3 * solid.positions.col(alarm->node);
-    const double speed = solid.velocities.col(alarm->node).norm();
-    throw coupling::CouplingFailed(fmt::format(
-        "window {} (t = {} s to {} s): solid interface node {} at ({:.3f}, {:.3f}, {:.3f}) mm (now at {:.3g} m/s) jumps "
-        "in velocity from window to window by {:.3g} m/s RMS over the last {} windows, and every one of the last {} "
-        "blocks of {} windows stood at or above coupling.runaway_standing_speed = {} m/s ({:.3g} m/s {} blocks ago): "
-        "the interface oscillates at the window's scale and does not settle. {}; raise runaway_standing_speed or "
-        "runaway_standing_blocks only if the leaflet really moves on the window's time scale",
-        window.index, window.time, window.time + window.size, alarm->node, where.x(), where.y(), where.z(), speed,
-        alarm->oscillation, alarm->block_windows, alarm->blocks, alarm->block_windows, settings.runaway_standing_speed,
-        alarm->oscillation_before, alarm->blocks, cause(alarm->node)));
-  }
   if (const auto& alarm = watch.alarm()) {
     const Eigen::Vector3d where = 1e3 * solid.positions.col(alarm->node);
     const double speed = solid.velocities.col(alarm->node).norm();
+    // The two rules differ only in what the blocks did and which fields to raise.
+    const std::string rule =
+        alarm->standing
+            ? fmt::format("every one of the last {} blocks of {} windows stood at or above "
+                          "coupling.runaway_standing_speed = {} m/s ({:.3g} m/s {} blocks ago): the interface "
+                          "oscillates at the window's scale and does not settle",
+                          alarm->blocks, alarm->block_windows, settings.runaway_standing_speed,
+                          alarm->oscillation_before, alarm->blocks)
+            : fmt::format("grown in each of the last {} blocks of {} windows from {:.3g} m/s, >= "
+                          "coupling.runaway_oscillation_speed = {} m/s: the interface is running away (slowly)",
+                          alarm->blocks, alarm->block_windows, alarm->oscillation_before,
+                          settings.runaway_oscillation_speed);
     throw coupling::CouplingFailed(fmt::format(
         "window {} (t = {} s to {} s): solid interface node {} at ({:.3f}, {:.3f}, {:.3f}) mm (now at {:.3g} m/s) jumps "
-        "in velocity from window to window by {:.3g} m/s RMS over the last {} windows, grown in each of the last {} "
-        "blocks of {} windows from {:.3g} m/s, >= coupling.runaway_oscillation_speed = {} m/s: the interface is running "
-        "away (slowly). {}; raise runaway_oscillation_speed or "
-        "runaway_growing_blocks only if the leaflet really moves on the window's time scale",
+        "in velocity from window to window by {:.3g} m/s RMS over the last {} windows, {}. {}; raise {} only if the "
+        "leaflet really moves on the window's time scale",
         window.index, window.time, window.time + window.size, alarm->node, where.x(), where.y(), where.z(), speed,
-        alarm->oscillation, alarm->block_windows, alarm->blocks, alarm->block_windows, alarm->oscillation_before,
-        settings.runaway_oscillation_speed, cause(alarm->node)));
+        alarm->oscillation, alarm->block_windows, rule, cause(alarm->node),
+        alarm->standing ? "runaway_standing_speed or runaway_standing_blocks"
+                        : "runaway_oscillation_speed or runaway_growing_blocks"));
   }
 }
 

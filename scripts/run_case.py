@@ -22,6 +22,7 @@ reported exactly as the programs would report it.
 import argparse
 import json
 import os
+import resource
 import shutil
 import signal
 import subprocess
@@ -143,6 +144,21 @@ def stop_all(programs, grace):
         program.waiter.join()
 
 
+def write_run_record(output_dir: Path, wall_s: float, exit_code: int, restart: Path | None) -> None:
+    """OUTPUT/wall_time.json: what the run cost (every run reports its wall time; the comparison
+    and join_segments read it). CPU time is the programs' (the launcher reaps them)."""
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    record = {"wall_time_s": round(wall_s, 3), "exit_code": exit_code,
+              "cpu_time_s": round(children.ru_utime + children.ru_stime, 3),
+              "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+    if restart:
+        record["restart_from"] = str(restart.resolve())
+    try:
+        (output_dir / "wall_time.json").write_text(json.dumps(record, indent=1) + "\n")
+    except OSError as error:  # the results matter more than their cost record
+        print(f"run_case: could not write {output_dir / 'wall_time.json'}: {error}", file=sys.stderr, flush=True)
+
+
 def main():
     started_at = time.monotonic()
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -248,6 +264,7 @@ def main():
     for program in programs:
         program.close()
     wall_s = time.monotonic() - started_at
+    write_run_record(output_dir, wall_s, exit_code, args.restart)
     if exit_code == 0:
         print(f"run_case: finished in {wall_s:.1f} s wall time; logs and results in {output_dir}", flush=True)
     else:

@@ -187,7 +187,8 @@ def smoothed(t: np.ndarray, r: np.ndarray, sigma: float) -> tuple[np.ndarray, np
     return grid, np.convolve(padded, kernel / kernel.sum(), mode="valid")
 
 
-def valve_events(t, radial_position, smoothing_s: float = VALVE_EVENTS_SMOOTHING_S) -> ValveEvents:
+def valve_events(t, radial_position, smoothing_s: float = VALVE_EVENTS_SMOOTHING_S,
+                 allow_open_end: bool = False) -> ValveEvents:
     """RVOT, RVCT, ET over one cycle of the free-edge radial position r(t) (docs/valve-scene.md,
     "Analysis"; the reference: "from the high positive/negative slope of the radial displacement
     curve", after Leyh et al. 1999).
@@ -201,7 +202,10 @@ def valve_events(t, radial_position, smoothing_s: float = VALVE_EVENTS_SMOOTHING
        it the steepest slope g of the smoothed curve is found.
     4. The tangent at the steepest point leaves one level and reaches the other: RVOT = dr / g
        (rise), RVCT = dr / |g| (fall); ET runs from the opening tangent's foot on r_closed to the
-       closing tangent's foot on r_closed. On a piecewise-linear history these are its corners."""
+       closing tangent's foot on r_closed. On a piecewise-linear history these are its corners.
+    allow_open_end: a history that ends before the valve closes (a run still going, or stopped)
+    gives the opening's events and NaN for the closing's (closing start and end, RVCT, ET);
+    r_open is then the median of what the open plateau has shown so far."""
     t = np.asarray(t, dtype=float)
     r = np.asarray(radial_position, dtype=float)
     if t.ndim != 1 or t.shape != r.shape or len(t) < 3 or np.any(np.diff(t) <= 0):
@@ -219,9 +223,9 @@ def valve_events(t, radial_position, smoothing_s: float = VALVE_EVENTS_SMOOTHING
         raise ValueError("valve_events: r(t) never rises through half of its range (starts open?)")
     downs = _crossings(ts, rs, half, False)
     downs = downs[downs > ups[0]]
-    if len(downs) == 0:
+    if len(downs) == 0 and not allow_open_end:
         raise ValueError("valve_events: r(t) does not open and close within the samples given")
-    rise_at, fall_at = ups[0], downs[-1]
+    rise_at = ups[0]
 
     def bracket(centre, before_level, before_up, after_level, after_up):
         before = _crossings(ts, rs, before_level, before_up)
@@ -237,6 +241,12 @@ def valve_events(t, radial_position, smoothing_s: float = VALVE_EVENTS_SMOOTHING
     g_up = float(slope[k])
     opening_start = ts[k] - (rs[k] - r_closed) / g_up
     opening_end = ts[k] + (r_open - rs[k]) / g_up
+    if len(downs) == 0:
+        if not g_up > 0:
+            raise ValueError("valve_events: no rising slope found around the opening")
+        nan = float("nan")
+        return ValveEvents(float(opening_start), float(opening_end), nan, nan, span / g_up, nan, nan, r_closed, r_open)
+    fall_at = downs[-1]
     falling = bracket(fall_at, high, False, low, False)
     k = int(np.flatnonzero(falling)[np.argmin(slope[falling])])
     g_down = -float(slope[k])

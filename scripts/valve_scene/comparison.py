@@ -18,13 +18,8 @@ hemodynamics.py and REFERENCE_FINDINGS below).
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import re
-import resource
-import subprocess
 import sys
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -32,7 +27,8 @@ import numpy as np
 
 from . import hemodynamics as hd
 from .analysis import ValveEvents, valve_events
-from .report import REFERENCE_KINEMATICS_MS, kinematics_table
+from .launch import launch, read_cost
+from .report import kinematics_table
 from .run_report import free_edge_kinematics
 from .waveform import PERIOD_S
 
@@ -97,6 +93,7 @@ class RunResult:
     leaks: int | None = None
     cycle_difference: dict = field(default_factory=dict)  # metric -> relative difference, cycle 1 vs 2
     cycle_values: tuple = ()                              # (previous cycle's, analysed cycle's) metrics
+    partial: bool = False                                 # the run ends before the analysed cycle does
 
 
 # ---------------------------------------------------------------------------------------------
@@ -122,27 +119,15 @@ def prepare_case(spec: RunSpec, work_dir: Path, end_time: float | None = None, c
 
 def _cpu_time(run_dir: Path) -> float | None:
     """CPU seconds of a run (all programs), when its wall_time.json recorded them."""
-    record = Path(run_dir) / "wall_time.json"
-    return json.loads(record.read_text()).get("cpu_time_s") if record.exists() else None
+    cost = read_cost(run_dir)
+    return cost.cpu_time_s if cost else None
 
 
 def run_one(spec: RunSpec, case: Path, run_dir: Path, build_dir: Path) -> tuple[float, int]:
-    """Runs the case through the launcher (one thread per program); returns (wall s, exit code)
-    and records them in RUN_DIR/wall_time.json."""
-    command = [sys.executable, str(REPO / "scripts" / "run_case.py"), str(case), "--output", str(run_dir),
-               "--build-dir", str(build_dir)] + (["--fe-only"] if spec.kind == "FE" else [])
-    env = {**os.environ, "OMP_NUM_THREADS": "1", "OMP_WAIT_POLICY": "passive"}
-    run_dir.mkdir(parents=True, exist_ok=True)
-    start = time.monotonic()
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    with open(run_dir.parent / f"{spec.name}.log", "w") as log:
-        code = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT, env=env, cwd=REPO).returncode
-    wall = time.monotonic() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    # the launcher waits for its programs, so their CPU is in the launcher's reaped children
-    cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
-    (run_dir / "wall_time.json").write_text(json.dumps({"wall_time_s": wall, "exit_code": code, "cpu_time_s": cpu}))
-    return wall, code
+    """Runs the case through the launcher (one thread per program); returns (wall s, exit code),
+    which the launcher records in RUN_DIR/wall_time.json."""
+    cost = launch(case, run_dir, build_dir, run_dir.parent / f"{spec.name}.log", fe_only=spec.kind == "FE", one_thread=True)
+    return cost.wall_time_s, cost.exit_code
 
 
 # ---------------------------------------------------------------------------------------------
@@ -266,23 +251,33 @@ def cycles_table(runs: dict, cycle: int) -> str:
     return "\n".join(lines) + "\n"
 
 
-def analyse_run(run: RunResult, cycle: int) -> RunResult:
+def _closure_time(events: ValveEvents | None) -> float | None:
+    """The closing end, when the run saw it (a partial cycle's is NaN)."""
+    return events.closing_end if events is not None and np.isfinite(events.closing_end) else None
+
+
+def analyse_run(run: RunResult, cycle: int, allow_partial: bool = False) -> RunResult:
+    """The run's metrics over the cycle. allow_partial: a run that ends inside the cycle (a long
+    coupled run stopped, or still going) is analysed up to its end: the opening's events without
+    the closing's, the hemodynamics up to the end (hemodynamics.analyse_cycle), the peaks and the
+    balance over what exists; run.partial says so and the report marks it."""
     d = run.spec.dimension
+    run.partial = allow_partial and run.simulated_s < cycle * PERIOD_S - 1e-9
     try:
         t, radial, width = free_edge_kinematics(run.run_dir, d, cycle)
         run.kinematics = {"t": t, "radial": radial, "width": width}
-        run.events = valve_events(t, radial)
+        run.events = valve_events(t, radial, allow_open_end=run.partial)
     except (FileNotFoundError, KeyError, ValueError) as error:
         run.events_error = str(error)
     try:
         run.peaks = solid_peaks(run.run_dir, cycle)
-    except (FileNotFoundError, KeyError) as error:
+    except (FileNotFoundError, KeyError):
         run.peaks = {}
     if run.spec.kind == "FSI":
         try:
             series = hd.read_run(run.run_dir)
-            run.hemodynamics = hd.analyse_cycle(series, cycle, closure_time_s=run.events.closing_end if run.events else None,
-                                                symmetry_factor=run.spec.symmetry_factor)
+            run.hemodynamics = hd.analyse_cycle(series, cycle, closure_time_s=_closure_time(run.events),
+                                                symmetry_factor=run.spec.symmetry_factor, allow_partial=run.partial)
         except (FileNotFoundError, KeyError, ValueError, IndexError) as error:
             run.hemodynamics_error = str(error)
         try:
@@ -529,7 +524,15 @@ def write_report(runs: dict, out: Path, command: str, cycle: int, dimension: int
              "## Runs and wall times", "",
              "| run | simulated (s) | wall time (s) | CPU time (s) | exit code |", "|---|---|---|---|---|"]
     for label, r in runs.items():
-        lines.append(f"| {r.spec.name} | {r.simulated_s:.4g} | {_fmt(r.wall_time_s, 0)} | {_fmt(_cpu_time(r.run_dir), 0)} | {r.exit_code} |")
+        simulated = f"{r.simulated_s:.4g}" + (f" (partial: cycle {cycle} to {(r.simulated_s - (cycle - 1) * PERIOD_S) * 1e3:.0f} ms)"
+                                              if r.partial else "")
+        lines.append(f"| {r.spec.name} | {simulated} | {_fmt(r.wall_time_s, 0)} | {_fmt(_cpu_time(r.run_dir), 0)} | "
+                     f"{'–' if r.exit_code is None else r.exit_code} |")
+    partial = [label for label, r in runs.items() if r.partial]
+    if partial:
+        lines += ["", f"Partial: {', '.join(partial)} end inside cycle {cycle}; their metrics cover what they ran "
+                  "(no closing events before the closing, no closed peaks before 270 ms, the hemodynamics to the run's "
+                  "end). A dash is a metric the runs do not reach."]
     lines += ["", "## Kinematics (reference Table 3)", "",
               kinematics_table({label: r.events for label, r in runs.items()})]
     errors = [f"{label}: {r.events_error}" for label, r in runs.items() if r.events_error]
@@ -580,7 +583,7 @@ def write_report(runs: dict, out: Path, command: str, cycle: int, dimension: int
                   f"Each metric measured the same way in both cycles; the difference is |c{cycle} − c{cycle - 1}| / |c{cycle}|, "
                   f"in bold where it reaches {CYCLE_TOLERANCE:.0%}.", "", table]
     plot_fig5(runs, figures / f"{stem}-fig5.png")
-    lines += ["## Figures", "", f"Free-edge motion (like Fig. 5; dashed FE-only, solid FSI):", "",
+    lines += ["## Figures", "", "Free-edge motion (like Fig. 5; dashed FE-only, solid FSI):", "",
               f"![fig5](figures/{stem}-fig5.png)", ""]
     if dimension == 2:
         plot_fig6_2d(runs, figures / f"{stem}-fig6.png", cycle)
@@ -601,22 +604,37 @@ def write_report(runs: dict, out: Path, command: str, cycle: int, dimension: int
 
 
 def compare(dimension: int, resolution: str, variant: str, runs_dir: Path, build_dir: Path, out: Path,
-            cycle: int, end_time: float | None, reuse: bool, command: str, cases_dir: Path = CASES_DIR) -> dict:
+            cycle: int, end_time: float | None, reuse: bool, command: str, cases_dir: Path = CASES_DIR,
+            existing: dict | None = None, allow_partial: bool = False) -> dict:
+    """existing: label ('FSI-MHGO', ...) -> a run folder to analyse as it is, never run here (a
+    long coupled run joined from its segments by join_segments); allow_partial: analyse runs
+    that end inside the cycle up to their end (analyse_run)."""
+    existing = existing or {}
+    unknown = sorted(set(existing) - {f"{k}-{m}" for k in KINDS for m in MATERIALS})
+    if unknown:
+        raise ValueError(f"--run {unknown[0]}=...: allowed labels are " + ", ".join(f"{k}-{m}" for k in KINDS for m in MATERIALS))
     runs = {}
     for kind in KINDS:
         for material in MATERIALS:
             spec = RunSpec(kind, material, dimension, resolution, variant)
-            run_dir = runs_dir / spec.name
-            record = run_dir / "wall_time.json"
-            if reuse and record.exists():
-                done = json.loads(record.read_text())
-                wall, code = done["wall_time_s"], done["exit_code"]
+            if spec.label in existing:
+                run_dir = Path(existing[spec.label]).resolve()
+                if not (run_dir / "solid_series.h5").exists():
+                    raise FileNotFoundError(f"--run {spec.label}={run_dir}: no solid_series.h5 there")
+                cost = read_cost(run_dir)
+                wall, code = (cost.wall_time_s, cost.exit_code) if cost else (None, None)
+            elif reuse and (runs_dir / spec.name / "wall_time.json").exists():
+                run_dir = runs_dir / spec.name
+                cost = read_cost(run_dir)
+                wall, code = cost.wall_time_s, cost.exit_code
             else:
+                run_dir = runs_dir / spec.name
                 case = prepare_case(spec, runs_dir / "cases", end_time, cases_dir)
                 wall, code = run_one(spec, case, run_dir, build_dir)
             result = RunResult(spec, run_dir, wall, code, _series_end(run_dir))
-            runs[spec.label] = analyse_run(result, cycle)
-            print(f"{spec.name}: exit {code}, {result.simulated_s:.4g} s simulated in {wall:.0f} s", flush=True)
+            runs[spec.label] = analyse_run(result, cycle, allow_partial)
+            print(f"{spec.name}: exit {code}, {result.simulated_s:.4g} s simulated in {_fmt(wall, 0)} s"
+                  + (" (partial cycle)" if result.partial else ""), flush=True)
     write_report(runs, out, command, cycle, dimension, resolution)
     return runs
 
@@ -632,10 +650,22 @@ def main(argv=None) -> None:
     parser.add_argument("--build-dir", type=Path, default=REPO / "build")
     parser.add_argument("--reuse", action="store_true", help="keep runs that finished before (RUN/wall_time.json)")
     parser.add_argument("--out", type=Path, default=REPO / "docs" / "comparison.md")
+    parser.add_argument("--run", action="append", default=[], metavar="LABEL=DIR",
+                        help="analyse this run folder for LABEL (FE-Ogden, FE-MHGO, FSI-Ogden, FSI-MHGO) instead of "
+                             "running its case, e.g. a long run joined by join_segments; repeatable")
+    parser.add_argument("--partial", action="store_true",
+                        help="analyse runs that end inside the cycle up to their end (marked in the report)")
     args = parser.parse_args(argv)
+    existing = {}
+    for item in args.run:
+        label, sep, folder = item.partition("=")
+        if not sep or not folder:
+            parser.error(f"--run {item}: expected LABEL=DIR")
+        existing[label] = Path(folder)
     command = "python -m valve_scene.comparison " + " ".join(a for a in (argv if argv is not None else sys.argv[1:]))
     compare(args.dimension, args.resolution, args.variant, args.runs_dir.resolve(), args.build_dir.resolve(),
-            args.out.resolve(), args.cycle, args.end_time, args.reuse, command)
+            args.out.resolve(), args.cycle, args.end_time, args.reuse, command, existing=existing,
+            allow_partial=args.partial)
     print(args.out)
 
 

@@ -10,17 +10,13 @@ Writes runs/<case>/ (solver output), docs/fe-only-study.md and docs/figures/fe-o
 from __future__ import annotations
 
 import argparse
-import json
-import resource
 import re
-import subprocess
-import sys
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from .launch import launch, read_cost
 from .analysis import (ROBUST_PEAK_FRACTION, ValveEvents, bisection_profile, geometric_orifice_area,
                        peak_with_location, robust_peak, triangle_areas, valve_events)
 from .valve_geometry import ValveParameters
@@ -58,20 +54,11 @@ class ModelResult:
 def run_case(spec: CaseSpec, build_dir: Path, log_dir: Path, runs_dir: Path = REPO / "runs") -> float:
     """Runs one FE-only case through the launcher; returns its wall time (s)."""
     out = runs_dir / spec.name
-    cmd = [sys.executable, str(REPO / "scripts" / "run_case.py"), str(CASES_DIR / f"{spec.name}.textproto"),
-           "--output", str(out), "--fe-only", "--build-dir", str(build_dir)]
-    log_dir.mkdir(parents=True, exist_ok=True)
-    start = time.monotonic()
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    with open(log_dir / f"{spec.name}.log", "w") as log:
-        result = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, cwd=REPO)
-    wall = time.monotonic() - start
-    if result.returncode != 0:
-        raise RuntimeError(f"{spec.name}: run_case.py exited with {result.returncode}; see {log_dir / (spec.name + '.log')}")
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
-    (out / "wall_time.json").write_text(json.dumps({"wall_time_s": wall, "cpu_time_s": cpu}))
-    return wall
+    log = log_dir / f"{spec.name}.log"
+    cost = launch(CASES_DIR / f"{spec.name}.textproto", out, build_dir, log, fe_only=True)
+    if cost.exit_code != 0:
+        raise RuntimeError(f"{spec.name}: run_case.py exited with {cost.exit_code}; see {log}")
+    return cost.wall_time_s
 
 
 # The cheap faithful study (--windows): the FE-only valve follows the pressure with no flow to
@@ -113,32 +100,18 @@ def run_window(spec: CaseSpec, window: tuple[float, float], build_dir: Path, run
     case_file = runs_dir / f"{name}.textproto"
     case_file.write_text(window_case_text(spec, *window))
     out = runs_dir / name
-    cmd = [sys.executable, str(REPO / "scripts" / "run_case.py"), str(case_file), "--output", str(out), "--fe-only",
-           "--build-dir", str(build_dir)]
-    start = time.monotonic()
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    with open(runs_dir / f"{name}.log", "w") as log:
-        result = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, cwd=REPO)
-    if result.returncode != 0:
-        raise RuntimeError(f"{name}: run_case.py exited with {result.returncode}; see {runs_dir / (name + '.log')}")
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    wall = time.monotonic() - start
-    cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
-    (out / "wall_time.json").write_text(json.dumps({"wall_time_s": wall, "cpu_time_s": cpu}))
-    return out, wall
+    cost = launch(case_file, out, build_dir, runs_dir / f"{name}.log", fe_only=True)
+    if cost.exit_code != 0:
+        raise RuntimeError(f"{name}: run_case.py exited with {cost.exit_code}; see {runs_dir / (name + '.log')}")
+    return out, cost.wall_time_s
 
 
 def recorded_times(run_dirs) -> tuple[float | None, float | None]:
     """Summed (wall, CPU) seconds of runs that recorded them (RUN/wall_time.json)."""
-    walls, cpus = [], []
-    for run_dir in run_dirs:
-        record = Path(run_dir) / "wall_time.json"
-        if record.exists():
-            data = json.loads(record.read_text())
-            walls.append(data.get("wall_time_s"))
-            cpus.append(data.get("cpu_time_s"))
-    ok = len(walls) == len(list(run_dirs)) and None not in walls
-    return (sum(walls) if ok else None), (sum(cpus) if ok and None not in cpus else None)
+    costs = [read_cost(run_dir) for run_dir in run_dirs]
+    walls = [c.wall_time_s if c else None for c in costs]
+    cpus = [c.cpu_time_s if c else None for c in costs]
+    return (None if None in walls else sum(walls)), (None if None in walls + cpus else sum(cpus))
 
 
 def analyse_windows(spec: CaseSpec, opening_dir: Path, closing_dir: Path, wall_time_s: float | None = None) -> ModelResult:

@@ -18,6 +18,7 @@ its last sample and the next segment's first is reported, never filled.
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -38,10 +39,12 @@ class JoinError(ValueError):
 class JoinReport:
     files: dict = field(default_factory=dict)   # file name -> (samples, first time, last time)
     gaps: list = field(default_factory=list)    # (file, from time, to time)
+    notes: list = field(default_factory=list)   # the cost record's fate
 
     def lines(self) -> list[str]:
         out = [f"{name}: {n} samples, {a:.6g}-{b:.6g} s" for name, (n, a, b) in self.files.items()]
         out += [f"gap in {name}: no samples between {a:.6g} s and {b:.6g} s" for name, a, b in self.gaps]
+        out += self.notes
         return out
 
 
@@ -176,7 +179,26 @@ def join(segments: list[Path], output: Path) -> JoinReport:
             join_series(present, output / name, report)
     if not report.files:
         raise JoinError(f"none of {', '.join(SERIES_FILES + (SNAPSHOT_FILE,))} in {', '.join(map(str, segments))}")
+    join_costs(segments, output, report)
     return report
+
+
+def join_costs(segments: list[Path], output: Path, report: JoinReport) -> None:
+    """OUTPUT/wall_time.json: the segments' wall and CPU times summed (a segment's time past the
+    next one's restart point included: it was spent), the last segment's exit code. Written only
+    when every segment has its launcher's record; otherwise the report names those without."""
+    records = {s: s / "wall_time.json" for s in segments}
+    missing = [str(s) for s, path in records.items() if not path.is_file()]
+    if missing:
+        report.notes.append(f"no cost record (wall_time.json) in {', '.join(missing)}: the joined run has none")
+        return
+    data = [json.loads(path.read_text()) for path in records.values()]
+    walls = [d.get("wall_time_s") for d in data]
+    cpus = [d.get("cpu_time_s") for d in data]
+    joined = {"wall_time_s": None if None in walls else sum(walls), "cpu_time_s": None if None in cpus else sum(cpus),
+              "exit_code": data[-1].get("exit_code"), "segments": [str(s.resolve()) for s in segments]}
+    (output / "wall_time.json").write_text(json.dumps(joined, indent=1) + "\n")
+    report.notes.append(f"wall time {joined['wall_time_s']} s, CPU time {joined['cpu_time_s']} s over {len(segments)} segments")
 
 
 def main(argv=None) -> int:

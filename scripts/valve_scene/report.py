@@ -30,7 +30,7 @@ REFERENCE_PEAKS = {
 
 
 def _fmt(value, scale=1.0, digits=1) -> str:
-    if value is None:
+    if value is None or (isinstance(value, float) and value != value):   # None or NaN: not measured
         return "–"
     if isinstance(value, str):
         return value

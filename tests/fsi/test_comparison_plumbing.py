@@ -3,6 +3,7 @@ the 2D xcoarse cases: the four runs go through the launcher, the report holds ev
 with the four runs, and each FSI run's interface balances (fluid work = solid work through the
 mapping, total forces equal) within the stated tolerance. The findings cannot be judged on 4 ms
 and must say so rather than pass."""
+import json
 import os
 import subprocess
 import sys
@@ -58,6 +59,32 @@ class ComparisonPlumbing(unittest.TestCase):
                 self.assertGreater(b["power_scale"], 0.0)       # the fluid did work on the leaflets
                 self.assertLess(b["work_relative_difference"], self.comparison.BALANCE_TOLERANCE)
                 self.assertLess(b["force_relative_difference"], self.comparison.BALANCE_TOLERANCE)
+
+    def test_the_launcher_records_each_runs_cost(self):
+        for label, run in self.runs.items():
+            with self.subTest(run=label):
+                record = json.loads((run.run_dir / "wall_time.json").read_text())
+                self.assertEqual(record["exit_code"], 0)
+                self.assertEqual(record["wall_time_s"], run.wall_time_s)
+                self.assertGreater(record["cpu_time_s"], 0.0)
+
+    def test_a_given_run_folder_is_analysed_as_it_is_and_marked_partial(self):
+        # a long run joined from segments is passed as a folder: nothing is run for it, and with
+        # allow_partial the 4 ms of cycle 1 are analysed and marked as partial
+        fsi = self.runs["FSI-MHGO"]
+        out = self.out.parent / "partial.md"
+        runs = self.comparison.compare(2, "xcoarse", "sector", Path(self.tmp.name) / "runs", BUILD, out, cycle=1,
+                                       end_time=END_TIME, reuse=True, command="partial",
+                                       existing={"FSI-MHGO": fsi.run_dir}, allow_partial=True)
+        self.assertTrue(all(r.partial for r in runs.values()))
+        self.assertEqual(runs["FSI-MHGO"].run_dir, fsi.run_dir.resolve())
+        self.assertEqual(runs["FSI-MHGO"].wall_time_s, fsi.wall_time_s)     # from the run's record
+        text = out.read_text()
+        self.assertIn(f"| fsi-mhgo-2d-xcoarse | {END_TIME:.4g} (partial: cycle 1 to 4 ms) |", text)
+        self.assertIn("Partial: FE-Ogden, FE-MHGO, FSI-Ogden, FSI-MHGO end inside cycle 1", text)
+        with self.assertRaisesRegex(ValueError, "allowed labels are FE-Ogden"):
+            self.comparison.compare(2, "xcoarse", "sector", Path(self.tmp.name) / "runs", BUILD, out, cycle=1,
+                                    end_time=END_TIME, reuse=True, command="x", existing={"FSI-mhgo": fsi.run_dir})
 
     def test_findings_are_not_judged_on_a_few_milliseconds(self):
         findings = {f.key: f for f in self.comparison.check_findings(self.runs)}

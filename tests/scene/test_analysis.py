@@ -182,6 +182,25 @@ class ValveEvents(unittest.TestCase):
         bounce = 2e-3 * np.exp(-((t - 0.300) / 0.010) ** 2)   # 2 mm rebound (> 10 %, < 50 %) at 300 ms
         self.assert_trapezoid_times(valve_events(t, self.trapezoid(t) + bounce), 1e-6)
 
+    def test_a_history_that_ends_open_gives_the_opening_only_when_allowed(self):
+        # a run stopped at 150 ms, still open (closed to 100 ms, opens over 20 ms, as the coupled
+        # valve's delayed opening; the levels are medians, so each needs its plateau to dominate):
+        # the opening's corners, NaN for the closing's
+        t = np.linspace(0.0, 0.15, 301)
+        r = np.interp(t, [0.0, 0.100, 0.120, 0.15], [0.3, 0.3, 10.0, 10.0]) * 1e-3
+        with self.assertRaisesRegex(ValueError, "does not open and close"):
+            valve_events(t, r)
+        events = valve_events(t, r, allow_open_end=True)
+        self.assertAlmostEqual(events.rvot, 0.020, delta=1e-9)
+        self.assertAlmostEqual(events.opening_start, 0.100, delta=1e-9)
+        self.assertAlmostEqual(events.opening_end, 0.120, delta=1e-9)
+        self.assertAlmostEqual(events.r_open, 10e-3, delta=1e-12)
+        for name in ("closing_start", "closing_end", "rvct", "et"):
+            self.assertTrue(math.isnan(getattr(events, name)), name)
+        # a whole cycle reads the same with or without the allowance
+        t = np.linspace(0.0, 0.8, 1601)
+        self.assertEqual(valve_events(t, self.trapezoid(t)), valve_events(t, self.trapezoid(t), allow_open_end=True))
+
     def test_a_valve_that_never_opens_is_reported(self):
         t = np.linspace(0, 0.8, 81)
         with self.assertRaisesRegex(ValueError, "never changes"):

@@ -1,4 +1,5 @@
 """Joining the output of a run continued from restarts (valve_scene.join_segments)."""
+import json
 import tempfile
 import unittest
 from pathlib import Path
@@ -77,6 +78,19 @@ class JoinSegmentsTest(unittest.TestCase):
     def test_segments_out_of_order_are_refused(self):
         with self.assertRaisesRegex(JoinError, "earliest first"):
             join([self.b, self.a], self.out)
+
+    def test_costs_are_summed_when_every_segment_has_its_record(self):
+        (self.a / "wall_time.json").write_text(json.dumps({"wall_time_s": 100.5, "cpu_time_s": 90.0, "exit_code": 143}))
+        report = join([self.a, self.b], self.out)
+        self.assertFalse((self.out / "wall_time.json").exists())          # b has no record
+        self.assertIn(f"no cost record (wall_time.json) in {self.b}", "\n".join(report.lines()))
+        (self.b / "wall_time.json").write_text(json.dumps({"wall_time_s": 20.25, "cpu_time_s": 18.0, "exit_code": 0}))
+        join([self.a, self.b], self.out)
+        joined = json.loads((self.out / "wall_time.json").read_text())
+        self.assertEqual(joined["wall_time_s"], 120.75)
+        self.assertEqual(joined["cpu_time_s"], 108.0)
+        self.assertEqual(joined["exit_code"], 0)                          # the last segment's
+        self.assertEqual(len(joined["segments"]), 2)
 
     def test_output_must_not_be_a_segment(self):
         with self.assertRaisesRegex(JoinError, "is one of the segments"):

@@ -204,13 +204,13 @@ def main():
         return [find_executable(name, build_dir, role)] + plan[role]["arguments"] + common
 
     commands = []
-    if args.restart and fe_only:
-        fail("--restart is for coupled runs (FE-only runs are short enough to repeat)")
+    restart = ["--restart", str(args.restart.resolve())] if args.restart else []
     if not fe_only:
-        restart = ["--restart", str(args.restart.resolve())] if args.restart else []
         commands.append(("coupler", [coupler] + common + restart))
     solid = command_for("solid", args.solid_exe)
-    commands.append(("solid", solid + (["--fe-only"] if fe_only else [])))
+    # FE-only: the solid reads its own restart point (a full-valve cycle takes hours); coupled: the
+    # coupler hands it to every participant
+    commands.append(("solid", solid + (["--fe-only"] + restart if fe_only else [])))
     if not fe_only:
         fluid = command_for("fluid", args.fluid_exe)
         if args.fluid_ranks > 1:

@@ -59,6 +59,10 @@ class ComparisonPlumbing(unittest.TestCase):
                 self.assertGreater(b["power_scale"], 0.0)       # the fluid did work on the leaflets
                 self.assertLess(b["work_relative_difference"], self.comparison.BALANCE_TOLERANCE)
                 self.assertLess(b["force_relative_difference"], self.comparison.BALANCE_TOLERANCE)
+                # the solid takes exactly the loads it was sent; the lag is their work minus the fluid's
+                self.assertLess(b["integrator_relative_difference"], self.comparison.INTEGRATOR_TOLERANCE)
+                self.assertAlmostEqual(b["lag_work"], b["load_work"] - b["work_fluid"], delta=1e-12 * b["load_work_scale"])
+                self.assertGreater(b["load_work_scale"], 0.0)
 
     def test_the_launcher_records_each_runs_cost(self):
         for label, run in self.runs.items():

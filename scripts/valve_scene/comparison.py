@@ -464,24 +464,53 @@ def plot_fig6_2d(runs: dict, path: Path, cycle: int, times_s=(0.0, 0.01, 0.02, 0
     plt.close(fig)
 
 
+def particle_files(run_dir: Path) -> list[Path]:
+    """The fluid's particle snapshot files of a run: its own, or, for a run joined from restart
+    segments (which does not copy them: too large), its segments' (join_segments.SEGMENTS_FILE)."""
+    from .join_segments import segments_of
+    return [d / "fluid_particles.h5" for d in [run_dir] + segments_of(run_dir) if (d / "fluid_particles.h5").exists()]
+
+
+def particle_spacing(x: np.ndarray, samples: int = 400, seed: int = 0) -> float:
+    """The median nearest-neighbour distance of a random sample of the particles (the lattice
+    spacing of a fluid that has moved off its lattice)."""
+    if len(x) < 2:
+        return 1e-3
+    rng = np.random.default_rng(seed)
+    picked = rng.choice(len(x), size=min(samples, len(x)), replace=False)
+    nearest = []
+    for i in picked:
+        d2 = np.sum((x - x[i]) ** 2, axis=1)
+        d2[i] = np.inf
+        nearest.append(np.sqrt(d2.min()))
+    return float(np.median(nearest))
+
+
 def velocity_slice(run_dir: Path, time_s: float, dimension: int):
     """(positions [n, 2] in the slice plane, speeds) of the fluid snapshot nearest time_s: in 2D
     all fluid particles; in 3D those within half a spacing of the plane y = 0."""
     import h5py
-    path = run_dir / "fluid_particles.h5"
-    with h5py.File(path, "r") as f:
-        names = sorted(n for n in f if n.startswith("snapshot_"))
-        if not names:
-            raise ValueError(f"{path}: no snapshot")
-        times = np.array([float(f[n].attrs["time"]) for n in names])
-        g = f[names[int(np.argmin(np.abs(times - time_s)))]]
+    nearest = None   # (distance in time, file, snapshot name)
+    for path in particle_files(run_dir):
+        with h5py.File(path, "r") as f:
+            for n in f:
+                if n.startswith("snapshot_"):
+                    d = abs(float(f[n].attrs["time"]) - time_s)
+                    if nearest is None or d < nearest[0]:
+                        nearest = (d, path, n)
+    if nearest is None:
+        raise ValueError(f"{run_dir}: no fluid particle snapshot (fluid_particles.h5) in the run or its segments")
+    with h5py.File(nearest[1], "r") as f:
+        g = f[nearest[2]]
         x, v, kind = g["position"][()], g["velocity"][()], g["kind"][()].reshape(-1)
         when = float(g.attrs["time"])
     fluid = kind == 0
     x, v = x[fluid], v[fluid]
     if dimension == 3:
-        spacing = np.median(np.diff(np.unique(np.round(x[:, 2], 6)))) if len(x) > 1 else 1e-3
-        keep = np.abs(x[:, 1]) < 0.5 * spacing
+        # one layer of particles at the plane y = 0 (the sector's mirror plane, which its fluid
+        # touches from one side only; a full valve's fluid from both)
+        spacing = particle_spacing(x)
+        keep = np.abs(x[:, 1]) < (1.0 if x[:, 1].min() > -0.5 * spacing else 0.5) * spacing
         return np.stack([x[keep, 2], x[keep, 0]], axis=1), np.linalg.norm(v[keep], axis=1), when
     return x[:, :2], np.linalg.norm(v[:, :2], axis=1), when
 
@@ -492,7 +521,7 @@ def plot_fig12(runs: dict, path: Path, cycle: int) -> str:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    shown = [r for r in runs.values() if r.spec.kind == "FSI" and (r.run_dir / "fluid_particles.h5").exists()]
+    shown = [r for r in runs.values() if r.spec.kind == "FSI" and particle_files(r.run_dir)]
     if not shown:
         return "no fluid snapshot"
     fig, axes = plt.subplots(len(shown), 1, figsize=(10, 3.0 * len(shown)), squeeze=False)

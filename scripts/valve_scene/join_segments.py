@@ -10,7 +10,8 @@ field snapshots (`solid_fields.h5`), segment k contributes its samples before th
 segment k + 1 (the later segment wins: it is the run that went on), in the order given. A series
 dataset is one whose first axis matches the `time` dataset of its own group or of a parent group;
 everything else (meshes, attributes) is taken from the last segment that has it. The fluid's
-particle snapshots are not joined (too large; open each segment's .xmf).
+particle snapshots are not joined (too large; open each segment's .xmf): the joined folder lists
+its segments in `segments.json`, where the report tools find them.
 
 A segment stopped by a signal may have lost the samples it had not yet flushed; the gap between
 its last sample and the next segment's first is reported, never filled.
@@ -27,6 +28,7 @@ import h5py
 import numpy as np
 
 SERIES_FILES = ("solid_series.h5", "coupling_series.h5", "fluid_probes.h5")
+SEGMENTS_FILE = "segments.json"   # the joined folder's list of its segments (for their particle snapshots)
 SNAPSHOT_FILE = "solid_fields.h5"
 GAP_FACTOR = 3.0  # a jump longer than this many median sample intervals is reported as a gap
 
@@ -179,8 +181,15 @@ def join(segments: list[Path], output: Path) -> JoinReport:
             join_series(present, output / name, report)
     if not report.files:
         raise JoinError(f"none of {', '.join(SERIES_FILES + (SNAPSHOT_FILE,))} in {', '.join(map(str, segments))}")
+    (output / SEGMENTS_FILE).write_text(json.dumps([str(s.resolve()) for s in segments], indent=1) + "\n")
     join_costs(segments, output, report)
     return report
+
+
+def segments_of(run_dir: Path) -> list[Path]:
+    """The segment folders a joined run was made from (empty for a run that was not joined)."""
+    path = Path(run_dir) / SEGMENTS_FILE
+    return [Path(s) for s in json.loads(path.read_text())] if path.is_file() else []
 
 
 def join_costs(segments: list[Path], output: Path, report: JoinReport) -> None:

@@ -92,6 +92,17 @@ class JoinSegmentsTest(unittest.TestCase):
         self.assertEqual(joined["exit_code"], 0)                          # the last segment's
         self.assertEqual(len(joined["segments"]), 2)
 
+    def test_the_joined_folder_lists_its_segments_for_their_particle_snapshots(self):
+        from valve_scene.comparison import particle_files
+        from valve_scene.join_segments import segments_of
+        with h5py.File(self.b / "fluid_particles.h5", "w") as f:
+            f.create_group("snapshot_000000").attrs["time"] = 0.3
+        join([self.a, self.b], self.out)
+        self.assertEqual(segments_of(self.out), [self.a.resolve(), self.b.resolve()])
+        self.assertEqual(segments_of(self.a), [])                       # not a joined run
+        # the velocity slice looks in the segments: only b has snapshots
+        self.assertEqual(particle_files(self.out), [self.b.resolve() / "fluid_particles.h5"])
+
     def test_output_must_not_be_a_segment(self):
         with self.assertRaisesRegex(JoinError, "is one of the segments"):
             join([self.a, self.b], self.b)

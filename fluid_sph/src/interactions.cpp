@@ -425,12 +425,15 @@ template <int D>
   return outside2 < support2;
 }
 
-// Which wall bodies' reactions compute_fluid_rates books, and where (one row per thread).
+// Which wall bodies' reactions compute_fluid_rates books, and where: per row of cells, summed
+// in row order afterwards, so that the bodies' forces (the plates' motion) do not depend on which
+// thread took which row (per-thread sums over the dynamic schedule made two runs differ in the
+// last bit on a loaded machine).
 template <int D>
 struct BodyBooking {
   int body_count = 0;          // 0: none
   bool include_fixed = false;  // book body 0 (the fixed walls) too
-  double* thread_forces = nullptr;  // body_count * D doubles for the calling thread
+  double* thread_forces = nullptr;  // body_count * D doubles for the block being booked (its row's)
   bool books(const Particles<D>& p, std::uint32_t b) const {
     return p.kind[b] == Kind::wall && p.body[b] < body_count && (p.body[b] != 0 || include_fixed);
   }
@@ -846,7 +849,7 @@ void update_wall_state(Particles<D>& p, const CellGrid<D>& grid, const FluidSett
       std::vector<WallNeighbour> list;
       for_each_lane_block<D, kBlock>(
           grid, [&](std::uint32_t a) { return p.kind[a] == Kind::wall || p.kind[a] == Kind::mirror_wall; },
-          [&](const std::uint32_t* lane_index, int n, const auto& segments, int count) {
+          [&](const std::uint32_t* lane_index, int n, const auto& segments, int count, std::ptrdiff_t /*row*/) {
             if (filter.touches(segments, count))
               cell_block_wall_state<D, true>(p, view, s, eos, W, lane_index, n, segments, count, filter, body_acceleration, support2, surely_outside2, lanes, list);
             else
@@ -877,8 +880,9 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
     *body_forces = compute_body_forces<D>(p, grid, s, static_cast<std::size_t>(body_count), include_fixed_walls, filter);
     return;
   }
-  const int threads = omp_get_max_threads();
-  std::vector<double> per_thread(static_cast<std::size_t>(threads) * static_cast<std::size_t>(std::max(body_count, 1)) * D, 0.0);
+  const std::size_t stride = static_cast<std::size_t>(std::max(body_count, 1)) * D;
+  const std::size_t rows = body_count > 0 ? grid.cell_count() / static_cast<std::size_t>(grid.cells_along(0)) : 0;
+  std::vector<double> per_row(rows * stride, 0.0);
     with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
 #pragma omp parallel
     {
@@ -887,13 +891,14 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
       BodyBooking<D> booking;
       booking.body_count = body_count;
       booking.include_fixed = include_fixed_walls;
-      booking.thread_forces = per_thread.data() + static_cast<std::size_t>(omp_get_thread_num()) * static_cast<std::size_t>(std::max(body_count, 1)) * D;
       // Rates are needed for the fluid; booked reactions also where mirror fluid meets a wall.
       auto wanted = [&](std::uint32_t a) {
         return a >= lane_begin && a < lane_end &&
                (p.kind[a] == Kind::fluid || (body_count > 0 && p.kind[a] == Kind::mirror_fluid && p.near_wall[a] != 0));
       };
-      for_each_lane_block<D, kBlock>(grid, wanted, [&](const std::uint32_t* lane_index, int n, const auto& segments, int count) {
+      for_each_lane_block<D, kBlock>(grid, wanted, [&](const std::uint32_t* lane_index, int n, const auto& segments, int count,
+                                                       std::ptrdiff_t row) {
+        if (body_count > 0) booking.thread_forces = per_row.data() + static_cast<std::size_t>(row) * stride;
         const bool masked = filter.touches(segments, count);
         auto run = [&]<bool AV, bool KS>() {
           if (body_count > 0) {
@@ -916,9 +921,9 @@ void compute_fluid_rates(Particles<D>& p, const CellGrid<D>& grid, const FluidSe
   });
   if (body_count == 0) return;
   body_forces->assign(static_cast<std::size_t>(body_count), Vec<D>{});
-  for (int t = 0; t < threads; ++t)
+  for (std::size_t r = 0; r < rows; ++r)
     for (int b = 0; b < body_count; ++b)
-      for (int d = 0; d < D; ++d) (*body_forces)[b][d] += per_thread[(static_cast<std::size_t>(t) * body_count + b) * D + d];
+      for (int d = 0; d < D; ++d) (*body_forces)[b][d] += per_row[r * stride + static_cast<std::size_t>(b) * D + d];
 }
 
 template <int D>
@@ -926,8 +931,11 @@ std::vector<Vec<D>> compute_body_forces(const Particles<D>& p, const CellGrid<D>
                                         std::size_t body_count, bool include_fixed_walls, const PairFilter<D>& filter) {
   const PairConstants<D> k(s);
   const ParticleView<D> view(p);
-  const int threads = omp_get_max_threads();
-  std::vector<double> per_thread(static_cast<std::size_t>(threads) * body_count * D, 0.0);
+  // Booked per chunk of cells (one thread takes a whole chunk) and summed in chunk order, so that
+  // the result does not depend on the thread schedule (as compute_fluid_rates books per row).
+  const std::size_t chunks = (grid.cell_count() + kCellChunk - 1) / kCellChunk;
+  const auto& starts = grid.cell_starts();
+  std::vector<double> per_chunk(chunks * body_count * D, 0.0);
   with_kernel<D>(s.kernel, s.smoothing_length(), [&](const auto& W) {
     for_each_particle_with_neighbours<D>(grid, [&](std::uint32_t w, const auto& segments, int count) {
       if (p.kind[w] != Kind::wall || p.body[w] >= body_count || !p.near_fluid[w]) return;
@@ -939,14 +947,17 @@ std::vector<Vec<D>> compute_body_forces(const Particles<D>& p, const CellGrid<D>
       else
         r = k.alpha_c0 > 0 ? pair_sums<D, true, true, false, false>(view, k, W, w, segments, count, filter)
                            : pair_sums<D, false, true, false, false>(view, k, W, w, segments, count, filter);
-      double* f = per_thread.data() + (static_cast<std::size_t>(omp_get_thread_num()) * body_count + p.body[w]) * D;
+      // w's cell: the last cell that starts at or before it (one thread takes a whole cell)
+      const auto cell = static_cast<std::size_t>(std::upper_bound(starts.begin(), starts.begin() + grid.cell_count() + 1, w) -
+                                                 starts.begin() - 1);
+      double* f = per_chunk.data() + ((cell / kCellChunk) * body_count + p.body[w]) * D;
       for (int d = 0; d < D; ++d) f[d] += static_cast<double>(k.mass) * k.mass * r.acc[d];
     });
   });
   std::vector<Vec<D>> forces(body_count, Vec<D>{});
-  for (int t = 0; t < threads; ++t)
+  for (std::size_t c = 0; c < chunks; ++c)
     for (std::size_t b = 0; b < body_count; ++b)
-      for (int d = 0; d < D; ++d) forces[b][d] += per_thread[(static_cast<std::size_t>(t) * body_count + b) * D + d];
+      for (int d = 0; d < D; ++d) forces[b][d] += per_chunk[(c * body_count + b) * D + d];
   return forces;
 }
 

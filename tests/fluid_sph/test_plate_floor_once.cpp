@@ -193,5 +193,23 @@ TEST(PlateFloorOnceReached, TheFlagSurvivesCheckpointsAndRestartFiles) {
   EXPECT_NEAR(early.plate_pressure_level(0.6 * T), F - A * std::sin(omega * 0.6 * T), 1e-9);  // ... until reached
 }
 
+// The plates' forces are booked per row of cells and summed in row order, so a run on two threads
+// is the run on one, bit for bit, step by step (per-thread sums made them differ in the last bit,
+// and two runs on two threads could differ under load).
+TEST(PlateForces, OneAndTwoThreadsGiveTheSameRunBitForBit) {
+  FluidSolver<2> one = channel(Drive::plain);
+  FluidSolver<2> two = channel(Drive::plain);
+  for (int step = 0; step < 400; ++step) {
+    omp_set_num_threads(1);
+    one.step();
+    omp_set_num_threads(2);
+    two.step();
+    ASSERT_EQ(one.plates()[0].fluid_force[0], two.plates()[0].fluid_force[0]) << "step " << step;
+    ASSERT_TRUE(same_state(one, two)) << "step " << step << ", t = " << one.time();
+  }
+  EXPECT_GT(std::abs(one.plates()[0].fluid_force[0]), 0.0);  // the plate pushed on the fluid
+  omp_set_num_threads(1);
+}
+
 }  // namespace
 }  // namespace valvefsi::fluid

@@ -7,6 +7,10 @@
 
 namespace valvefsi::fluid {
 
+// Cells are shared out in chunks of this many (one thread takes a whole chunk): a sum that must not
+// depend on the thread schedule is booked per chunk (cell / kCellChunk) and summed in order.
+inline constexpr std::size_t kCellChunk = 32;
+
 // body(a, segments, segment_count) is called once for every particle a (sorted index).
 template <int D, class Body>
 void for_each_particle_with_neighbours(const CellGrid<D>& grid, Body&& body) {
@@ -14,7 +18,7 @@ void for_each_particle_with_neighbours(const CellGrid<D>& grid, Body&& body) {
 #pragma omp parallel
   {
     std::array<NeighbourSegment<D>, (D == 2 ? 9 : 27)> segments;
-#pragma omp for schedule(dynamic, 32)
+#pragma omp for schedule(dynamic, kCellChunk)
     for (std::ptrdiff_t c = 0; c < cells; ++c) {
       const std::uint32_t first = grid.cell_start(static_cast<std::size_t>(c));
       const std::uint32_t last = grid.cell_start(static_cast<std::size_t>(c) + 1);
@@ -31,8 +35,9 @@ namespace valvefsi::fluid {
 
 // Lanes for the SIMD block passes. Along each row of cells (x), the particles `wanted(a)`
 // selects are taken in sorted order in blocks of up to BlockSize that span at most two
-// adjacent cells, and body(lanes, n, segments, segment_count) gets each block with the
-// neighbour segments of its cells. Full blocks across cell borders waste no padded lanes (a
+// adjacent cells, and body(lanes, n, segments, segment_count, row) gets each block with the
+// neighbour segments of its cells and the index of its row (rows are shared out dynamically,
+// so a sum that must not depend on the thread schedule is booked per row, not per thread). Full blocks across cell borders waste no padded lanes (a
 // cell holds ~18 particles in 3D), and only the wanted particles (fluid for the rates, walls
 // for the wall state) take lanes. Orphaned worksharing: call it inside a parallel region.
 template <int D, int BlockSize, class Wanted, class Body>
@@ -49,7 +54,7 @@ void for_each_lane_block(const CellGrid<D>& grid, Wanted&& wanted, Body&& body) 
     std::size_t first_cell = row_first, last_cell = row_first;
     auto flush = [&]() {
       const int count = grid.neighbour_segments(first_cell, last_cell, segments);
-      body(static_cast<const std::uint32_t*>(lanes), n, segments, count);
+      body(static_cast<const std::uint32_t*>(lanes), n, segments, count, row);
       n = 0;
     };
     for (std::size_t c = row_first; c < row_first + nx; ++c) {

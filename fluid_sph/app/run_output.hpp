@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,7 @@ class RunOutput {
   // total force on the interface (ignored without interface columns).
   void write_due(const FluidSolver<D>& solver, const Vec<D>& interface_force = {}) {
     const double t = solver.time();
+    if (std::isnan(first_time_)) first_time_ = t;  // a restarted run's rate counts from its restart time
     if (snapshot_interval_ > 0 && t >= next_snapshot_ * (1 - 1e-12)) {
       snapshots_.write(solver);
       while (next_snapshot_ <= t * (1 + 1e-12)) next_snapshot_ += snapshot_interval_;
@@ -73,7 +75,7 @@ class RunOutput {
     if (std::chrono::duration<double>(now - last_report_).count() > 10.0) {
       last_report_ = now;
       const double elapsed = std::chrono::duration<double>(now - start_).count();
-      const double eta = elapsed / std::max(t, 1e-30) * (end_time_ - t);
+      const double eta = elapsed / std::max(t - first_time_, 1e-30) * (end_time_ - t);
       spdlog::info("t = {:.5f} / {} s, step {}, dt = {:.3e} s, lost {}, elapsed {}, left ~{}", t, end_time_,
                    solver.step_count(), solver.time_step(), solver.lost_count(), hms(elapsed), hms(eta));
     }
@@ -146,6 +148,7 @@ class RunOutput {
   double end_time_, snapshot_interval_, series_interval_;
   double next_snapshot_ = 0.0, next_sample_ = 0.0;
   double last_sample_time_ = -1.0;
+  double first_time_ = std::numeric_limits<double>::quiet_NaN();
   Clock::time_point start_, last_report_;
 };
 

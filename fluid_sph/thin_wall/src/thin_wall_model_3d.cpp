@@ -718,218 +718,239 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
   const bool with_kernel_sum = p.kernel_sum.size() == p.size();
   if (s.state.size() != node_count_) s.state.assign(node_count_, NodeState{});
 
-  const int threads = omp_get_max_threads();
-  std::vector<Vec3> per_thread(static_cast<std::size_t>(threads) * node_count_, Vec3{0, 0, 0});
-  const auto count = static_cast<std::ptrdiff_t>(p.size());
+  node_loads_.reset(node_count_, p.size());
+  const auto blocks = static_cast<std::ptrdiff_t>(node_loads_.block_count());
   with_kernel<3>(fluid_.kernel, h, [&](const auto& W) {
 #pragma omp parallel
     {
-      Vec3* forces = per_thread.data() + static_cast<std::size_t>(omp_get_thread_num()) * node_count_;
-      std::vector<double> side_scratch;  // signed distance of the particle from each candidate's plane
+      OrderedNodeLoads<3>::Booking forces(node_loads_);
+      std::vector<double>
+          side_scratch;  // signed distance of the particle from each candidate's plane
       std::vector<ClosestPoint3> sheets;
       std::vector<std::uint32_t> one;  // one sheet's candidates
       std::vector<std::array<Vec3, 2>> free_edges;
-      // Static chunks: each thread's share, and so the node loads' summation order, is the
-      // same in every run with the same thread count (restarts continue bit for bit).
-#pragma omp for schedule(static, 16)
-      for (std::ptrdiff_t aa = 0; aa < count; ++aa) {
-        const auto a = static_cast<std::size_t>(aa);
-        if (p.kind[a] != Kind::fluid || !s.near[a].near) continue;
-        const auto& cand = s.candidates[a];
-        const std::vector<double>* cand_distance = distances_of(a);
-        const Vec3 xa = position_of(p, a);
-        const double* side_a = sides_of(a, xa);  // as cached at the classify, or the same values now
-        if (side_a == nullptr) {
-          side_scratch.resize(cand.size());
-          for (std::size_t k = 0; k < cand.size(); ++k) side_scratch[k] = plane_side(face_normal_, face_offset_, cand[k], xa);
-          side_a = side_scratch.data();
-        }
-        const double rho_a = rho0 + p.density_excess[a];
-        const double inv_a = 1.0 / rho_a;
-        const double p_a = p.pressure[a];
-        const Vec3 va{p.velocity[0][a], p.velocity[1][a], p.velocity[2][a]};
-        const Vec3 vva{p.viscous_velocity[0][a], p.viscous_velocity[1][a], p.viscous_velocity[2][a]};
-        double acc[3] = {0, 0, 0}, cont = 0, csum = 0, cg[3] = {0, 0, 0};
-        // The free edges within the support (experiment fluid_state_round_free_edge).
-        free_edges.clear();
-        if (settings_.fluid_state_round_free_edge)
-          for (const std::uint32_t t : cand)
-            for (std::size_t e = 0; e < 3; ++e)
-              if (mesh_.edge_on_boundary[t][e])
-                free_edges.push_back({mesh_.position[mesh_.triangles[t][e]], mesh_.position[mesh_.triangles[t][(e + 1) % 3]]});
-        // One lattice behind each sheet (connected piece of the mesh with its images) within
-        // the support: the nearest, and another facing the particle across a narrow gap (the
-        // leaflet and its image in the coaptation plane 0.56 dp apart: a particle between them
-        // needs the kernel filled behind both, or it is pushed into the gap).
-        sheets.clear();
-        sheets.push_back(s.near[a].closest);
-        for (std::size_t k = 0; k < cand.size(); ++k) {
-          const int piece = sheet_of_triangle_[cand[k]];
-          bool known = false;
-          for (const auto& seen : sheets) known = known || sheet_of_triangle_[seen.triangle] == piece;
-          if (known) continue;
-          one.clear();
-          for (std::size_t m = k; m < cand.size(); ++m)
-            if (sheet_of_triangle_[cand[m]] == piece) one.push_back(cand[m]);
-          const ClosestPoint3 other = closest_point(mesh_, one, xa);
-          // Seen directly, not through a nearer sheet (then its shadow is that sheet's).
-          bool hidden = false;
-          for (const std::uint32_t t : cand) {
-            if (hidden || sheet_of_triangle_[t] == piece) continue;
-            const double sp = dot(face_normal_[t], xa) - face_offset_[t], sq = dot(face_normal_[t], other.point) - face_offset_[t];
-            if (!may_meet(face_box_[t], sp, sq, xa, other.point)) continue;
-            hidden = crossing(mesh_, t, xa, other.point).has_value();
+      // The node loads are booked per block of particles and summed in block order
+      // (OrderedNodeLoads): the same in every run, on any number of threads.
+#pragma omp for schedule(dynamic, 4)
+      for (std::ptrdiff_t block = 0; block < blocks; ++block) {
+        const auto [first, last] = node_loads_.block_range(static_cast<std::size_t>(block));
+        for (std::size_t a = first; a < last; ++a) {
+          if (p.kind[a] != Kind::fluid || !s.near[a].near) continue;
+          const auto& cand = s.candidates[a];
+          const std::vector<double>* cand_distance = distances_of(a);
+          const Vec3 xa = position_of(p, a);
+          const double* side_a =
+              sides_of(a, xa);  // as cached at the classify, or the same values now
+          if (side_a == nullptr) {
+            side_scratch.resize(cand.size());
+            for (std::size_t k = 0; k < cand.size(); ++k)
+              side_scratch[k] = plane_side(face_normal_, face_offset_, cand[k], xa);
+            side_a = side_scratch.data();
           }
-          if (other.distance < R && !hidden) sheets.push_back(other);
-        }
-        for (std::size_t sheet = 0; sheet < sheets.size(); ++sheet) {
-        const ClosestPoint3& c = sheets[sheet];
-        if (c.on_boundary && !settings_.lattice_beyond_free_edge) continue;
-        const int only_piece = sheet == 0 ? -1 : sheet_of_triangle_[c.triangle];
-        const int k_side = side_index(c.side);
-        // Lattice axes: n from the closest point towards the particle (turns smoothly round a
-        // free edge), t1 and t2 across it.
-        Vec3 n = sub(xa, c.point);
-        const double nl = norm(n);
-        if (nl > 1e-9 * dp) {
-          n = {n[0] / nl, n[1] / nl, n[2] / nl};
-        } else {
-          n = face_normal_[c.triangle];
-          n = {c.side * n[0], c.side * n[1], c.side * n[2]};
-        }
-        const int least = std::abs(n[0]) <= std::abs(n[1]) && std::abs(n[0]) <= std::abs(n[2]) ? 0 : (std::abs(n[1]) <= std::abs(n[2]) ? 1 : 2);
-        Vec3 e{0, 0, 0};
-        e[static_cast<std::size_t>(least)] = 1.0;
-        Vec3 t1 = cross(n, e);
-        const double t1l = norm(t1);
-        t1 = {t1[0] / t1l, t1[1] / t1l, t1[2] / t1l};
-        const Vec3 t2 = cross(n, t1);
-        const double first_depth = settings_.particle_aligned_layers ? delta - std::fmod(nl, delta) : 0.5 * delta;
-        // Layers in front of the tangent plane too: on the concave side of a curved leaflet the
-        // shadow reaches in front of it (R^2 / 2 rho_c: 0.4 dp at the sector's belly); the
-        // shadow test keeps only the points behind the mesh.
-        const int first_layer = settings_.lattice_in_front ? 1 - layers : 1;
-        for (int l = first_layer; l <= layers; ++l) {
-          const double depth = first_depth + (l - 1) * delta;
-          if (depth <= -nl) continue;  // not beyond the particle's own position
-          // x_a - x_v = (nl + depth) n - i delta t1 - j delta t2 (n, t1, t2 orthonormal), so only
-          // |i|, |j| within the layer's disc can pass the r2 test below: the rest are skipped
-          // before computing them. The bound is widened by 1e-6 of R^2, far above the rounding
-          // of r2 and the particle's offset from the axis when nl ~ 0 (1e-9 dp): the points
-          // tested, and their order, are those that passed before.
-          const double along = nl + depth;
-          const double room = R * R * (1.0 + 1e-6) - along * along;
-          if (room < 0.0) continue;
-          const int span_i = std::min(layers, static_cast<int>(std::sqrt(room) / delta));
-          for (int i = -span_i; i <= span_i; ++i) {
-            const double room_i = room - (i * delta) * (i * delta);
-            if (room_i < 0.0) continue;
-            const int span_j = std::min(layers, static_cast<int>(std::sqrt(room_i) / delta));
-            for (int j = -span_j; j <= span_j; ++j) {
-              Vec3 xv;
-              for (int d = 0; d < 3; ++d) xv[d] = c.point[d] + i * delta * t1[d] + j * delta * t2[d] - depth * n[d];
-              const Vec3 r = sub(xa, xv);
-              const double r2 = dot(r, r);
-              if (r2 >= R * R) continue;
-              // Beyond a free edge the lattice's middle column lies on the ray from the particle
-              // through the closest point on the edge: it only grazes the edge and stands for
-              // the fluid beyond it, so it is left out (as in 2D, two_sided_wall.cpp). Asked of
-              // the crossing test, it would count or not by round-off and the tolerance.
-              if (c.on_boundary && i == 0 && j == 0) continue;
-              // In the shadow: the segment from the particle to the point meets the mesh; the
-              // wall point q where it does carries the state. The candidates come nearest
-              // first, so the first hit is the one by the closest point (on a folded mesh
-              // the segment may meet it twice; the nearer triangle is the one in between).
-              std::optional<Crossing3> hit;
-              // Only candidates within |a x_v| of a can be met on the way (nearest first).
-              const double reach = cand_distance ? std::sqrt(r2) + reach_margin() : std::numeric_limits<double>::infinity();
-              for (std::size_t k = 0; k < cand.size() && !hit; ++k) {
-                if (cand_distance && (*cand_distance)[k] > reach) break;
-                const std::uint32_t t = cand[k];
-                const double sv = dot(face_normal_[t], xv) - face_offset_[t];
-                if (!may_meet(face_box_[t], side_a[k], sv, xa, xv)) continue;
-                hit = crossing(mesh_, t, xa, xv);
-              }
-              if (!hit) continue;
-              if (only_piece >= 0 && sheet_of_triangle_[hit->triangle] != only_piece) continue;  // another sheet's shadow
-              const std::size_t t = hit->triangle;
-              const auto& tri = mesh_.triangles[t];
-              const int map = triangle_map_[t];
-              // Reachable round a free edge within the support: the fluid there is the other
-              // side's, flowing round the edge, not fluid moving with the wall (the 2D plate's
-              // lever on the edge's excess, docs/thin-leaflet.md).
-              bool round_edge = false;
-              for (std::size_t e = 0; e < free_edges.size() && !round_edge; ++e) {
-                const auto& [e0, e1] = free_edges[e];
-                if (distance_to_segment(xa, e0, e1) + distance_to_segment(xv, e0, e1) >= R) continue;
-                round_edge = path_through_segment(xa, xv, e0, e1) < R;
-              }
-              const int k_state = round_edge ? 1 - k_side : k_side;
-              Vec3 q{0, 0, 0}, vw{0, 0, 0}, aw{0, 0, 0}, ve{0, 0, 0};
-              double p_v = 0;
-              for (int k = 0; k < 3; ++k) {
-                const double w = hit->barycentric[static_cast<std::size_t>(k)];
-                const std::uint32_t m = tri[static_cast<std::size_t>(k)];
-                const SideState& st = s.state[origin_node_[m]].side[static_cast<std::size_t>(k_state)];
-                p_v += w * st.pressure;
-                const Vec3 vst = to_image(map, st.velocity);
-                for (int d = 0; d < 3; ++d) {
-                  q[d] += w * mesh_.position[m][d];
-                  vw[d] += w * mesh_velocity_[m][d];
-                  aw[d] += w * mesh_acceleration_[m][d];
-                  ve[d] += w * vst[d];
+          const double rho_a = rho0 + p.density_excess[a];
+          const double inv_a = 1.0 / rho_a;
+          const double p_a = p.pressure[a];
+          const Vec3 va{p.velocity[0][a], p.velocity[1][a], p.velocity[2][a]};
+          const Vec3 vva{p.viscous_velocity[0][a], p.viscous_velocity[1][a],
+                         p.viscous_velocity[2][a]};
+          double acc[3] = {0, 0, 0}, cont = 0, csum = 0, cg[3] = {0, 0, 0};
+          // The free edges within the support (experiment fluid_state_round_free_edge).
+          free_edges.clear();
+          if (settings_.fluid_state_round_free_edge)
+            for (const std::uint32_t t : cand)
+              for (std::size_t e = 0; e < 3; ++e)
+                if (mesh_.edge_on_boundary[t][e])
+                  free_edges.push_back({mesh_.position[mesh_.triangles[t][e]],
+                                        mesh_.position[mesh_.triangles[t][(e + 1) % 3]]});
+          // One lattice behind each sheet (connected piece of the mesh with its images) within
+          // the support: the nearest, and another facing the particle across a narrow gap (the
+          // leaflet and its image in the coaptation plane 0.56 dp apart: a particle between them
+          // needs the kernel filled behind both, or it is pushed into the gap).
+          sheets.clear();
+          sheets.push_back(s.near[a].closest);
+          for (std::size_t k = 0; k < cand.size(); ++k) {
+            const int piece = sheet_of_triangle_[cand[k]];
+            bool known = false;
+            for (const auto& seen : sheets)
+              known = known || sheet_of_triangle_[seen.triangle] == piece;
+            if (known) continue;
+            one.clear();
+            for (std::size_t m = k; m < cand.size(); ++m)
+              if (sheet_of_triangle_[cand[m]] == piece) one.push_back(cand[m]);
+            const ClosestPoint3 other = closest_point(mesh_, one, xa);
+            // Seen directly, not through a nearer sheet (then its shadow is that sheet's).
+            bool hidden = false;
+            for (const std::uint32_t t : cand) {
+              if (hidden || sheet_of_triangle_[t] == piece) continue;
+              const double sp = dot(face_normal_[t], xa) - face_offset_[t],
+                           sq = dot(face_normal_[t], other.point) - face_offset_[t];
+              if (!may_meet(face_box_[t], sp, sq, xa, other.point)) continue;
+              hidden = crossing(mesh_, t, xa, other.point).has_value();
+            }
+            if (other.distance < R && !hidden) sheets.push_back(other);
+          }
+          for (std::size_t sheet = 0; sheet < sheets.size(); ++sheet) {
+            const ClosestPoint3& c = sheets[sheet];
+            if (c.on_boundary && !settings_.lattice_beyond_free_edge) continue;
+            const int only_piece = sheet == 0 ? -1 : sheet_of_triangle_[c.triangle];
+            const int k_side = side_index(c.side);
+            // Lattice axes: n from the closest point towards the particle (turns smoothly round a
+            // free edge), t1 and t2 across it.
+            Vec3 n = sub(xa, c.point);
+            const double nl = norm(n);
+            if (nl > 1e-9 * dp) {
+              n = {n[0] / nl, n[1] / nl, n[2] / nl};
+            } else {
+              n = face_normal_[c.triangle];
+              n = {c.side * n[0], c.side * n[1], c.side * n[2]};
+            }
+            const int least = std::abs(n[0]) <= std::abs(n[1]) && std::abs(n[0]) <= std::abs(n[2])
+                                  ? 0
+                                  : (std::abs(n[1]) <= std::abs(n[2]) ? 1 : 2);
+            Vec3 e{0, 0, 0};
+            e[static_cast<std::size_t>(least)] = 1.0;
+            Vec3 t1 = cross(n, e);
+            const double t1l = norm(t1);
+            t1 = {t1[0] / t1l, t1[1] / t1l, t1[2] / t1l};
+            const Vec3 t2 = cross(n, t1);
+            const double first_depth =
+                settings_.particle_aligned_layers ? delta - std::fmod(nl, delta) : 0.5 * delta;
+            // Layers in front of the tangent plane too: on the concave side of a curved leaflet the
+            // shadow reaches in front of it (R^2 / 2 rho_c: 0.4 dp at the sector's belly); the
+            // shadow test keeps only the points behind the mesh.
+            const int first_layer = settings_.lattice_in_front ? 1 - layers : 1;
+            for (int l = first_layer; l <= layers; ++l) {
+              const double depth = first_depth + (l - 1) * delta;
+              if (depth <= -nl) continue;  // not beyond the particle's own position
+              // x_a - x_v = (nl + depth) n - i delta t1 - j delta t2 (n, t1, t2 orthonormal), so
+              // only |i|, |j| within the layer's disc can pass the r2 test below: the rest are
+              // skipped before computing them. The bound is widened by 1e-6 of R^2, far above the
+              // rounding of r2 and the particle's offset from the axis when nl ~ 0 (1e-9 dp): the
+              // points tested, and their order, are those that passed before.
+              const double along = nl + depth;
+              const double room = R * R * (1.0 + 1e-6) - along * along;
+              if (room < 0.0) continue;
+              const int span_i = std::min(layers, static_cast<int>(std::sqrt(room) / delta));
+              for (int i = -span_i; i <= span_i; ++i) {
+                const double room_i = room - (i * delta) * (i * delta);
+                if (room_i < 0.0) continue;
+                const int span_j = std::min(layers, static_cast<int>(std::sqrt(room_i) / delta));
+                for (int j = -span_j; j <= span_j; ++j) {
+                  Vec3 xv;
+                  for (int d = 0; d < 3; ++d)
+                    xv[d] = c.point[d] + i * delta * t1[d] + j * delta * t2[d] - depth * n[d];
+                  const Vec3 r = sub(xa, xv);
+                  const double r2 = dot(r, r);
+                  if (r2 >= R * R) continue;
+                  // Beyond a free edge the lattice's middle column lies on the ray from the
+                  // particle through the closest point on the edge: it only grazes the edge and
+                  // stands for the fluid beyond it, so it is left out (as in 2D,
+                  // two_sided_wall.cpp). Asked of the crossing test, it would count or not by
+                  // round-off and the tolerance.
+                  if (c.on_boundary && i == 0 && j == 0) continue;
+                  // In the shadow: the segment from the particle to the point meets the mesh; the
+                  // wall point q where it does carries the state. The candidates come nearest
+                  // first, so the first hit is the one by the closest point (on a folded mesh
+                  // the segment may meet it twice; the nearer triangle is the one in between).
+                  std::optional<Crossing3> hit;
+                  // Only candidates within |a x_v| of a can be met on the way (nearest first).
+                  const double reach = cand_distance ? std::sqrt(r2) + reach_margin()
+                                                     : std::numeric_limits<double>::infinity();
+                  for (std::size_t k = 0; k < cand.size() && !hit; ++k) {
+                    if (cand_distance && (*cand_distance)[k] > reach) break;
+                    const std::uint32_t t = cand[k];
+                    const double sv = dot(face_normal_[t], xv) - face_offset_[t];
+                    if (!may_meet(face_box_[t], side_a[k], sv, xa, xv)) continue;
+                    hit = crossing(mesh_, t, xa, xv);
+                  }
+                  if (!hit) continue;
+                  if (only_piece >= 0 && sheet_of_triangle_[hit->triangle] != only_piece)
+                    continue;  // another sheet's shadow
+                  const std::size_t t = hit->triangle;
+                  const auto& tri = mesh_.triangles[t];
+                  const int map = triangle_map_[t];
+                  // Reachable round a free edge within the support: the fluid there is the other
+                  // side's, flowing round the edge, not fluid moving with the wall (the 2D plate's
+                  // lever on the edge's excess, docs/thin-leaflet.md).
+                  bool round_edge = false;
+                  for (std::size_t e = 0; e < free_edges.size() && !round_edge; ++e) {
+                    const auto& [e0, e1] = free_edges[e];
+                    if (distance_to_segment(xa, e0, e1) + distance_to_segment(xv, e0, e1) >= R)
+                      continue;
+                    round_edge = path_through_segment(xa, xv, e0, e1) < R;
+                  }
+                  const int k_state = round_edge ? 1 - k_side : k_side;
+                  Vec3 q{0, 0, 0}, vw{0, 0, 0}, aw{0, 0, 0}, ve{0, 0, 0};
+                  double p_v = 0;
+                  for (int k = 0; k < 3; ++k) {
+                    const double w = hit->barycentric[static_cast<std::size_t>(k)];
+                    const std::uint32_t m = tri[static_cast<std::size_t>(k)];
+                    const SideState& st =
+                        s.state[origin_node_[m]].side[static_cast<std::size_t>(k_state)];
+                    p_v += w * st.pressure;
+                    const Vec3 vst = to_image(map, st.velocity);
+                    for (int d = 0; d < 3; ++d) {
+                      q[d] += w * mesh_.position[m][d];
+                      vw[d] += w * mesh_velocity_[m][d];
+                      aw[d] += w * mesh_acceleration_[m][d];
+                      ve[d] += w * vst[d];
+                    }
+                  }
+                  if (!settings_.wall_acceleration_in_pressure) aw = {0, 0, 0};
+                  for (int d = 0; d < 3; ++d)
+                    p_v += rho0 * (fluid_.gravity[d] - aw[d]) * (xv[d] - q[d]);
+                  Vec3 vv_v;
+                  for (int d = 0; d < 3; ++d) vv_v[d] = 2.0 * vw[d] - ve[d];  // no-slip
+                  if (round_edge) vw = vv_v = ve;  // moves with that side's fluid
+                  const double inv_v =
+                      1.0 / (rho0 + eos.density_excess(p_v - fluid_.background_pressure));
+                  const double dist = std::sqrt(r2);
+                  const double F = W.gradient_factor(static_cast<float>(dist));
+                  const double wv = W.value(static_cast<float>(dist));
+                  const double inv_rr = inv_a * inv_v;
+                  const double vdx =
+                      (va[0] - vw[0]) * r[0] + (va[1] - vw[1]) * r[1] + (va[2] - vw[2]) * r[2];
+                  double radial = -(p_a + p_v) * inv_rr;
+                  if (alpha_c0 > 0)
+                    radial +=
+                        alpha_c0 * h * std::min(vdx, 0.0) / (r2 + eta2) * 0.5 * (inv_a + inv_v);
+                  radial *= F;
+                  const double viscous = two_mu * inv_rr * F;
+                  Vec3 da;
+                  for (int d = 0; d < 3; ++d)
+                    da[d] = mass_v * (radial * r[d] + viscous * (vva[d] - vv_v[d]));
+                  for (int d = 0; d < 3; ++d) acc[d] += da[d];
+                  cont += mass_v * vdx * F;
+                  csum += mass_v * wv * inv_v;
+                  for (int d = 0; d < 3; ++d) cg[d] += mass_v * F * r[d] * inv_v;
+                  // Action = reaction onto the nodes of the triangle seen, from the gauge pressure
+                  // p - p_b (docs/thin-leaflet.md, "Coupled runs"); a load seen on a mirror image
+                  // is the mirror fluid's load on the real leaflet, reflected back.
+                  const double gauge = 2.0 * fluid_.background_pressure * inv_rr * F * mass_v;
+                  Vec3 load;
+                  for (int d = 0; d < 3; ++d) load[d] = -mass_a * (da[d] + gauge * r[d]);
+                  load = to_real(map, load);
+                  for (int k = 0; k < 3; ++k) {
+                    const double w = hit->barycentric[static_cast<std::size_t>(k)];
+                    auto& f = forces.at(origin_node_[tri[static_cast<std::size_t>(k)]]);
+                    for (int d = 0; d < 3; ++d) f[d] += w * load[d];
+                  }
                 }
-              }
-              if (!settings_.wall_acceleration_in_pressure) aw = {0, 0, 0};
-              for (int d = 0; d < 3; ++d) p_v += rho0 * (fluid_.gravity[d] - aw[d]) * (xv[d] - q[d]);
-              Vec3 vv_v;
-              for (int d = 0; d < 3; ++d) vv_v[d] = 2.0 * vw[d] - ve[d];  // no-slip
-              if (round_edge) vw = vv_v = ve;  // moves with that side's fluid
-              const double inv_v = 1.0 / (rho0 + eos.density_excess(p_v - fluid_.background_pressure));
-              const double dist = std::sqrt(r2);
-              const double F = W.gradient_factor(static_cast<float>(dist));
-              const double wv = W.value(static_cast<float>(dist));
-              const double inv_rr = inv_a * inv_v;
-              const double vdx = (va[0] - vw[0]) * r[0] + (va[1] - vw[1]) * r[1] + (va[2] - vw[2]) * r[2];
-              double radial = -(p_a + p_v) * inv_rr;
-              if (alpha_c0 > 0) radial += alpha_c0 * h * std::min(vdx, 0.0) / (r2 + eta2) * 0.5 * (inv_a + inv_v);
-              radial *= F;
-              const double viscous = two_mu * inv_rr * F;
-              Vec3 da;
-              for (int d = 0; d < 3; ++d) da[d] = mass_v * (radial * r[d] + viscous * (vva[d] - vv_v[d]));
-              for (int d = 0; d < 3; ++d) acc[d] += da[d];
-              cont += mass_v * vdx * F;
-              csum += mass_v * wv * inv_v;
-              for (int d = 0; d < 3; ++d) cg[d] += mass_v * F * r[d] * inv_v;
-              // Action = reaction onto the nodes of the triangle seen, from the gauge pressure
-              // p - p_b (docs/thin-leaflet.md, "Coupled runs"); a load seen on a mirror image
-              // is the mirror fluid's load on the real leaflet, reflected back.
-              const double gauge = 2.0 * fluid_.background_pressure * inv_rr * F * mass_v;
-              Vec3 load;
-              for (int d = 0; d < 3; ++d) load[d] = -mass_a * (da[d] + gauge * r[d]);
-              load = to_real(map, load);
-              for (int k = 0; k < 3; ++k) {
-                const double w = hit->barycentric[static_cast<std::size_t>(k)];
-                Vec3& f = forces[origin_node_[tri[static_cast<std::size_t>(k)]]];
-                for (int d = 0; d < 3; ++d) f[d] += w * load[d];
               }
             }
           }
+          for (int d = 0; d < 3; ++d) p.acceleration[d][a] += static_cast<float>(acc[d]);
+          p.density_rate[a] += static_cast<float>(cont);
+          if (with_kernel_sum) {
+            p.kernel_sum[a] += static_cast<float>(csum);
+            for (int d = 0; d < 3; ++d) p.kernel_sum_gradient[d][a] += static_cast<float>(cg[d]);
+          }
         }
-        }
-        for (int d = 0; d < 3; ++d) p.acceleration[d][a] += static_cast<float>(acc[d]);
-        p.density_rate[a] += static_cast<float>(cont);
-        if (with_kernel_sum) {
-          p.kernel_sum[a] += static_cast<float>(csum);
-          for (int d = 0; d < 3; ++d) p.kernel_sum_gradient[d][a] += static_cast<float>(cg[d]);
-        }
+        forces.close_block(static_cast<std::size_t>(block));
       }
     }
   });
-  s.force.assign(node_count_, Vec3{0, 0, 0});
-  for (int th = 0; th < threads; ++th)
-    for (std::size_t m = 0; m < node_count_; ++m)
-      for (int d = 0; d < 3; ++d) s.force[m][d] += per_thread[static_cast<std::size_t>(th) * node_count_ + m][d];
+  node_loads_.sum_into(s.force);
 }
 
 bool ThinWallModel3D::accept_shift(const Particles<3>& p, std::size_t i, const Vec<3>& shift) {

@@ -210,148 +210,166 @@ void TwoSidedWall::add_wall_rates(Particles<2>& p) {
   const bool with_kernel_sum = p.kernel_sum.size() == p.size();
   virtual_kernel_sum_.assign(p.size(), 0.0f);
 
-  const int threads = omp_get_max_threads();
-  std::vector<Vec2> per_thread(static_cast<std::size_t>(threads) * markers_.size(), Vec2{0.0, 0.0});
-  const auto count = static_cast<std::ptrdiff_t>(p.size());
+  marker_loads_.reset(markers_.size(), p.size());
+  const auto blocks = static_cast<std::ptrdiff_t>(marker_loads_.block_count());
   with_kernel<2>(fluid_.kernel, h, [&](const auto& W) {
-    // Static chunks: the markers' loads are summed in the same order in every run with the
-    // same thread count (restarts continue bit for bit).
-#pragma omp parallel for schedule(static, 16)
-    for (std::ptrdiff_t aa = 0; aa < count; ++aa) {
-      const auto a = static_cast<std::size_t>(aa);
-      if (p.kind[a] != Kind::fluid || !near_[a].near) continue;
-      Vec2* forces = per_thread.data() + static_cast<std::size_t>(omp_get_thread_num()) * markers_.size();
-      const ClosestPoint& c = near_[a].closest;
-      const Vec2 xa = position_of(p, a);
-      // Lattice axes: n from the closest point towards the particle (rotates smoothly around
-      // a free end), t along the wall.
-      Vec2 n{xa[0] - c.point[0], xa[1] - c.point[1]};
-      const double nl = std::sqrt(dot(n, n));
-      if (nl > 1e-9 * dp) {
-        n = {n[0] / nl, n[1] / nl};
-      } else {
-        n = wall_.normal(c.segment);
-        n = {c.side * n[0], c.side * n[1]};
-      }
-      const Vec2 t{-n[1], n[0]};
-      const int k_side = side_index(c.side);
-      const double rho_a = rho0 + p.density_excess[a];
-      const double inv_a = 1.0 / rho_a;
-      const double p_a = p.pressure[a];
-      const Vec2 va{p.velocity[0][a], p.velocity[1][a]};
-      const Vec2 vva{p.viscous_velocity[0][a], p.viscous_velocity[1][a]};
-      double acc[2] = {0, 0}, cont = 0, csum = 0, cg[2] = {0, 0}, wsum = 0;
-      for (int j = 1; j <= layers; ++j) {
-        const double depth = (j - 0.5) * delta;
-        for (int i = -layers; i <= layers; ++i) {
-          const Vec2 xv{c.point[0] + i * delta * t[0] - depth * n[0], c.point[1] + i * delta * t[1] - depth * n[1]};
-          const Vec2 r{xa[0] - xv[0], xa[1] - xv[1]};
-          const double r2 = dot(r, r);
-          if (r2 >= R * R) continue;
-          std::size_t seg;
-          double tw;
-          // Beyond a free end the lattice's middle column lies on the ray from the particle
-          // through the end node: it only grazes the tip and stands for the fluid beyond it,
-          // so it is left out. Asked of first_crossing, the answer depended on round-off and
-          // the loads jumped by % when the motion changed by an ulp (issue 8: the coupler's
-          // implicit iterations could not converge).
-          if (settings_.shadow_only && c.at_free_end && i == 0) continue;
-          if (settings_.shadow_only) {
-            const auto hit = first_crossing(wall_, candidates_[a], xa, xv);
-            if (!hit) continue;
-            seg = hit->segment;
-            tw = hit->t;
+#pragma omp parallel
+    {
+      OrderedNodeLoads<2>::Booking forces(marker_loads_);
+      // The markers' loads are booked per block of particles and summed in block order
+      // (OrderedNodeLoads): the same in every run, on any number of threads.
+#pragma omp for schedule(dynamic, 4)
+      for (std::ptrdiff_t block = 0; block < blocks; ++block) {
+        const auto [first, last] = marker_loads_.block_range(static_cast<std::size_t>(block));
+        for (std::size_t a = first; a < last; ++a) {
+          if (p.kind[a] != Kind::fluid || !near_[a].near) continue;
+          const ClosestPoint& c = near_[a].closest;
+          const Vec2 xa = position_of(p, a);
+          // Lattice axes: n from the closest point towards the particle (rotates smoothly around
+          // a free end), t along the wall.
+          Vec2 n{xa[0] - c.point[0], xa[1] - c.point[1]};
+          const double nl = std::sqrt(dot(n, n));
+          if (nl > 1e-9 * dp) {
+            n = {n[0] / nl, n[1] / nl};
           } else {
-            const ClosestPoint cv = closest_point(wall_, candidates_[a], xv);
-            seg = cv.segment;
-            tw = cv.t;
+            n = wall_.normal(c.segment);
+            n = {c.side * n[0], c.side * n[1]};
           }
-          // That side's wall state at the wall point q where the particle sees the virtual
-          // point, extrapolated hydrostatically (with the wall's acceleration) to it.
-          const Vec2 q = wall_.point(seg, tw);
-          const MarkerWeights mw = markers_.weights_at(markers_.arc_length(seg, tw));
-          int k_state = k_side;
-          bool beyond = false;
-          if (settings_.opposite_state_beyond_edge || settings_.fluid_velocity_beyond_edge) {
-            const Vec2 e{wall_.position[seg + 1][0] - wall_.position[seg][0], wall_.position[seg + 1][1] - wall_.position[seg][1]};
-            const double along = ((xv[0] - wall_.position[seg][0]) * e[0] + (xv[1] - wall_.position[seg][1]) * e[1]) / dot(e, e);
-            beyond = (seg == 0 && along < 0.0) || (seg + 1 == wall_.segment_count() && along > 1.0);
-            if (beyond && settings_.opposite_state_beyond_edge) k_state = 1 - k_side;
+          const Vec2 t{-n[1], n[0]};
+          const int k_side = side_index(c.side);
+          const double rho_a = rho0 + p.density_excess[a];
+          const double inv_a = 1.0 / rho_a;
+          const double p_a = p.pressure[a];
+          const Vec2 va{p.velocity[0][a], p.velocity[1][a]};
+          const Vec2 vva{p.viscous_velocity[0][a], p.viscous_velocity[1][a]};
+          double acc[2] = {0, 0}, cont = 0, csum = 0, cg[2] = {0, 0}, wsum = 0;
+          for (int j = 1; j <= layers; ++j) {
+            const double depth = (j - 0.5) * delta;
+            for (int i = -layers; i <= layers; ++i) {
+              const Vec2 xv{c.point[0] + i * delta * t[0] - depth * n[0],
+                            c.point[1] + i * delta * t[1] - depth * n[1]};
+              const Vec2 r{xa[0] - xv[0], xa[1] - xv[1]};
+              const double r2 = dot(r, r);
+              if (r2 >= R * R) continue;
+              std::size_t seg;
+              double tw;
+              // Beyond a free end the lattice's middle column lies on the ray from the particle
+              // through the end node: it only grazes the tip and stands for the fluid beyond it,
+              // so it is left out. Asked of first_crossing, the answer depended on round-off and
+              // the loads jumped by % when the motion changed by an ulp (issue 8: the coupler's
+              // implicit iterations could not converge).
+              if (settings_.shadow_only && c.at_free_end && i == 0) continue;
+              if (settings_.shadow_only) {
+                const auto hit = first_crossing(wall_, candidates_[a], xa, xv);
+                if (!hit) continue;
+                seg = hit->segment;
+                tw = hit->t;
+              } else {
+                const ClosestPoint cv = closest_point(wall_, candidates_[a], xv);
+                seg = cv.segment;
+                tw = cv.t;
+              }
+              // That side's wall state at the wall point q where the particle sees the virtual
+              // point, extrapolated hydrostatically (with the wall's acceleration) to it.
+              const Vec2 q = wall_.point(seg, tw);
+              const MarkerWeights mw = markers_.weights_at(markers_.arc_length(seg, tw));
+              int k_state = k_side;
+              bool beyond = false;
+              if (settings_.opposite_state_beyond_edge || settings_.fluid_velocity_beyond_edge) {
+                const Vec2 e{wall_.position[seg + 1][0] - wall_.position[seg][0],
+                             wall_.position[seg + 1][1] - wall_.position[seg][1]};
+                const double along = ((xv[0] - wall_.position[seg][0]) * e[0] +
+                                      (xv[1] - wall_.position[seg][1]) * e[1]) /
+                                     dot(e, e);
+                beyond =
+                    (seg == 0 && along < 0.0) || (seg + 1 == wall_.segment_count() && along > 1.0);
+                if (beyond && settings_.opposite_state_beyond_edge) k_state = 1 - k_side;
+              }
+              bool round_edge = false;
+              if (settings_.other_side_round_edge || settings_.fluid_velocity_round_edge) {
+                for (const Vec2& e : {wall_.position.front(), wall_.position.back()})
+                  round_edge = round_edge || std::hypot(xa[0] - e[0], xa[1] - e[1]) +
+                                                     std::hypot(xv[0] - e[0], xv[1] - e[1]) <
+                                                 R;
+                if (round_edge && settings_.other_side_round_edge) k_state = 1 - k_side;
+              }
+              // The virtual point stands for moving fluid, not for the wall.
+              const bool fluid_like = (beyond && settings_.fluid_velocity_beyond_edge) ||
+                                      (round_edge && settings_.fluid_velocity_round_edge);
+              const SideState& s0 = markers_[mw.first].side[k_state];
+              const SideState& s1 = markers_[mw.second].side[k_state];
+              Vec2 vw = wall_.velocity_at(seg, tw);
+              if (fluid_like)
+                for (int d = 0; d < 2; ++d)
+                  vw[d] = mw.w0 * s0.extrapolated_velocity[d] + mw.w1 * s1.extrapolated_velocity[d];
+              const Vec2 aw = settings_.wall_acceleration_in_pressure
+                                  ? wall_.acceleration_at(seg, tw)
+                                  : Vec2{0.0, 0.0};
+              double p_v = mw.w0 * s0.pressure + mw.w1 * s1.pressure;
+              for (int d = 0; d < 2; ++d)
+                p_v += rho0 * (fluid_.gravity[d] - aw[d]) * (xv[d] - q[d]);
+              Vec2 vv_v;
+              for (int d = 0; d < 2; ++d)
+                vv_v[d] = fluid_like ? vw[d]
+                                     : 2.0 * vw[d] - (mw.w0 * s0.extrapolated_velocity[d] +
+                                                      mw.w1 * s1.extrapolated_velocity[d]);
+              const double inv_v =
+                  1.0 / (rho0 + eos.density_excess(p_v - fluid_.background_pressure));
+              const double dist = std::sqrt(r2);
+              const double F = W.gradient_factor(static_cast<float>(dist));
+              const double wv = W.value(static_cast<float>(dist));
+              const double inv_rr = inv_a * inv_v;
+              const double vdx = (va[0] - vw[0]) * r[0] + (va[1] - vw[1]) * r[1];
+              double radial = -(p_a + p_v) * inv_rr;
+              if (alpha_c0 > 0)
+                radial += alpha_c0 * h * std::min(vdx, 0.0) / (r2 + eta2) * 0.5 * (inv_a + inv_v);
+              radial *= F;
+              const double viscous = two_mu * inv_rr * F;
+              double da[2];
+              for (int d = 0; d < 2; ++d)
+                da[d] = mass_v * (radial * r[d] + viscous * (vva[d] - vv_v[d]));
+              acc[0] += da[0];
+              acc[1] += da[1];
+              if (settings_.normal_only_continuity && !fluid_like) {
+                // Only the wall's normal motion compresses the fluid: tangential slip along the
+                // wall does not (a truncated lattice near a free end would not cancel it).
+                const Vec2 nq = wall_.normal(seg);
+                const double vn = (va[0] - vw[0]) * nq[0] + (va[1] - vw[1]) * nq[1];
+                cont += mass_v * vn * (nq[0] * r[0] + nq[1] * r[1]) * F;
+              } else {
+                cont += mass_v * vdx * F;
+              }
+              csum += mass_v * wv * inv_v;
+              cg[0] += mass_v * F * r[0] * inv_v;
+              cg[1] += mass_v * F * r[1] * inv_v;
+              wsum += wv * delta * delta;
+              // Action = reaction: the opposite force goes to the markers that carried the state,
+              // from the gauge pressure p - p_b: the background pressure is an offset of the
+              // equation of state, and where only one side of a leaflet is wetted (against a
+              // rigid wall, at a closed tip) it would push the leaflet (57 N/m on the 2D valve at
+              // rest). Where both sides are wetted the two offsets cancel anyway.
+              const double gauge = 2.0 * fluid_.background_pressure * inv_rr * F * mass_v;
+              for (int d = 0; d < 2; ++d) {
+                const double load = mass_a * (da[d] + gauge * r[d]);
+                forces.at(mw.first)[d] -= mw.w0 * load;
+                forces.at(mw.second)[d] -= mw.w1 * load;
+              }
+            }
           }
-          bool round_edge = false;
-          if (settings_.other_side_round_edge || settings_.fluid_velocity_round_edge) {
-            for (const Vec2& e : {wall_.position.front(), wall_.position.back()})
-              round_edge = round_edge || std::hypot(xa[0] - e[0], xa[1] - e[1]) + std::hypot(xv[0] - e[0], xv[1] - e[1]) < R;
-            if (round_edge && settings_.other_side_round_edge) k_state = 1 - k_side;
+          for (int d = 0; d < 2; ++d) p.acceleration[d][a] += static_cast<float>(acc[d]);
+          p.density_rate[a] += static_cast<float>(cont);
+          if (with_kernel_sum) {
+            p.kernel_sum[a] += static_cast<float>(csum);
+            for (int d = 0; d < 2; ++d) p.kernel_sum_gradient[d][a] += static_cast<float>(cg[d]);
           }
-          // The virtual point stands for moving fluid, not for the wall.
-          const bool fluid_like = (beyond && settings_.fluid_velocity_beyond_edge) || (round_edge && settings_.fluid_velocity_round_edge);
-          const SideState& s0 = markers_[mw.first].side[k_state];
-          const SideState& s1 = markers_[mw.second].side[k_state];
-          Vec2 vw = wall_.velocity_at(seg, tw);
-          if (fluid_like)
-            for (int d = 0; d < 2; ++d) vw[d] = mw.w0 * s0.extrapolated_velocity[d] + mw.w1 * s1.extrapolated_velocity[d];
-          const Vec2 aw = settings_.wall_acceleration_in_pressure ? wall_.acceleration_at(seg, tw) : Vec2{0.0, 0.0};
-          double p_v = mw.w0 * s0.pressure + mw.w1 * s1.pressure;
-          for (int d = 0; d < 2; ++d) p_v += rho0 * (fluid_.gravity[d] - aw[d]) * (xv[d] - q[d]);
-          Vec2 vv_v;
-          for (int d = 0; d < 2; ++d)
-            vv_v[d] = fluid_like
-                          ? vw[d]
-                          : 2.0 * vw[d] - (mw.w0 * s0.extrapolated_velocity[d] + mw.w1 * s1.extrapolated_velocity[d]);
-          const double inv_v = 1.0 / (rho0 + eos.density_excess(p_v - fluid_.background_pressure));
-          const double dist = std::sqrt(r2);
-          const double F = W.gradient_factor(static_cast<float>(dist));
-          const double wv = W.value(static_cast<float>(dist));
-          const double inv_rr = inv_a * inv_v;
-          const double vdx = (va[0] - vw[0]) * r[0] + (va[1] - vw[1]) * r[1];
-          double radial = -(p_a + p_v) * inv_rr;
-          if (alpha_c0 > 0) radial += alpha_c0 * h * std::min(vdx, 0.0) / (r2 + eta2) * 0.5 * (inv_a + inv_v);
-          radial *= F;
-          const double viscous = two_mu * inv_rr * F;
-          double da[2];
-          for (int d = 0; d < 2; ++d) da[d] = mass_v * (radial * r[d] + viscous * (vva[d] - vv_v[d]));
-          acc[0] += da[0];
-          acc[1] += da[1];
-          if (settings_.normal_only_continuity && !fluid_like) {
-            // Only the wall's normal motion compresses the fluid: tangential slip along the
-            // wall does not (a truncated lattice near a free end would not cancel it).
-            const Vec2 nq = wall_.normal(seg);
-            const double vn = (va[0] - vw[0]) * nq[0] + (va[1] - vw[1]) * nq[1];
-            cont += mass_v * vn * (nq[0] * r[0] + nq[1] * r[1]) * F;
-          } else {
-            cont += mass_v * vdx * F;
-          }
-          csum += mass_v * wv * inv_v;
-          cg[0] += mass_v * F * r[0] * inv_v;
-          cg[1] += mass_v * F * r[1] * inv_v;
-          wsum += wv * delta * delta;
-          // Action = reaction: the opposite force goes to the markers that carried the state,
-          // from the gauge pressure p - p_b: the background pressure is an offset of the
-          // equation of state, and where only one side of a leaflet is wetted (against a
-          // rigid wall, at a closed tip) it would push the leaflet (57 N/m on the 2D valve at
-          // rest). Where both sides are wetted the two offsets cancel anyway.
-          const double gauge = 2.0 * fluid_.background_pressure * inv_rr * F * mass_v;
-          for (int d = 0; d < 2; ++d) {
-            const double load = mass_a * (da[d] + gauge * r[d]);
-            forces[mw.first][d] -= mw.w0 * load;
-            forces[mw.second][d] -= mw.w1 * load;
-          }
+          virtual_kernel_sum_[a] = static_cast<float>(wsum);
         }
+        forces.close_block(static_cast<std::size_t>(block));
       }
-      for (int d = 0; d < 2; ++d) p.acceleration[d][a] += static_cast<float>(acc[d]);
-      p.density_rate[a] += static_cast<float>(cont);
-      if (with_kernel_sum) {
-        p.kernel_sum[a] += static_cast<float>(csum);
-        for (int d = 0; d < 2; ++d) p.kernel_sum_gradient[d][a] += static_cast<float>(cg[d]);
-      }
-      virtual_kernel_sum_[a] = static_cast<float>(wsum);
     }
   });
-  for (auto& m : markers_.markers()) m.force = {0.0, 0.0};
-  for (int th = 0; th < threads; ++th)
-    for (std::size_t m = 0; m < markers_.size(); ++m)
-      for (int d = 0; d < 2; ++d) markers_[m].force[d] += per_thread[static_cast<std::size_t>(th) * markers_.size() + m][d];
+  marker_loads_.sum_into(marker_force_);
+  for (std::size_t m = 0; m < markers_.size(); ++m) markers_[m].force = marker_force_[m];
 }
 
 void TwoSidedWall::begin_step(const Particles<2>& p) {

@@ -31,6 +31,7 @@
 #include "valvefsi/fluid/immersed_surface.hpp"
 #include "valvefsi/fluid/mirror_group.hpp"
 #include "valvefsi/fluid/thin_wall/load_smoothing.hpp"
+#include "valvefsi/fluid/thin_wall/ordered_node_loads.hpp"
 #include "valvefsi/fluid/thin_wall/triangle_mesh.hpp"
 #include "valvefsi/fluid/thin_wall/window_motion.hpp"
 
@@ -198,6 +199,7 @@ class ThinWallModel3D final : public ImmersedSurfaceModel<3> {
   std::uint64_t generation_ = 0;  // of the per-particle data (new at each classify or restore): keys the blocking's per-thread caches
   NodeLoadSmoother smoother_;
   Dynamic dyn_;
+  OrderedNodeLoads<3> node_loads_;  // scratch of add_surface_rates
   std::optional<Dynamic> checkpoint_;
 };
 

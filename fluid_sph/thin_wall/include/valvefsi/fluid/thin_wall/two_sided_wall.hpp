@@ -21,6 +21,7 @@
 #include "valvefsi/fluid/fluid_settings.hpp"
 #include "valvefsi/fluid/particles.hpp"
 #include "valvefsi/fluid/thin_wall/markers.hpp"
+#include "valvefsi/fluid/thin_wall/ordered_node_loads.hpp"
 #include "valvefsi/fluid/thin_wall/polyline.hpp"
 #include "valvefsi/fluid/thin_wall/restart_arrays.hpp"
 
@@ -124,6 +125,8 @@ class TwoSidedWall {
 
   Polyline wall_;
   MarkerSet markers_;
+  OrderedNodeLoads<2> marker_loads_;  // scratch of add_wall_rates
+  std::vector<Vec2> marker_force_;
   FluidSettings<2> fluid_;
   ThinWallSettings settings_;
   WallCounters counters_;

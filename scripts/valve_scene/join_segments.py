@@ -27,6 +27,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from .launch import RECORD, read_cost
+
 SERIES_FILES = ("solid_series.h5", "coupling_series.h5", "fluid_probes.h5")
 SEGMENTS_FILE = "segments.json"   # the joined folder's list of its segments (for their particle snapshots)
 SNAPSHOT_FILE = "solid_fields.h5"
@@ -196,17 +198,16 @@ def join_costs(segments: list[Path], output: Path, report: JoinReport) -> None:
     """OUTPUT/wall_time.json: the segments' wall and CPU times summed (a segment's time past the
     next one's restart point included: it was spent), the last segment's exit code. Written only
     when every segment has its launcher's record; otherwise the report names those without."""
-    records = {s: s / "wall_time.json" for s in segments}
-    missing = [str(s) for s, path in records.items() if not path.is_file()]
+    costs = {s: read_cost(s) for s in segments}
+    missing = [str(s) for s, cost in costs.items() if cost is None]
     if missing:
-        report.notes.append(f"no cost record (wall_time.json) in {', '.join(missing)}: the joined run has none")
+        report.notes.append(f"no cost record ({RECORD}) in {', '.join(missing)}: the joined run has none")
         return
-    data = [json.loads(path.read_text()) for path in records.values()]
-    walls = [d.get("wall_time_s") for d in data]
-    cpus = [d.get("cpu_time_s") for d in data]
+    walls = [c.wall_time_s for c in costs.values()]
+    cpus = [c.cpu_time_s for c in costs.values()]
     joined = {"wall_time_s": None if None in walls else sum(walls), "cpu_time_s": None if None in cpus else sum(cpus),
-              "exit_code": data[-1].get("exit_code"), "segments": [str(s.resolve()) for s in segments]}
-    (output / "wall_time.json").write_text(json.dumps(joined, indent=1) + "\n")
+              "exit_code": costs[segments[-1]].exit_code, "segments": [str(s.resolve()) for s in segments]}
+    (output / RECORD).write_text(json.dumps(joined, indent=1) + "\n")
     report.notes.append(f"wall time {joined['wall_time_s']} s, CPU time {joined['cpu_time_s']} s over {len(segments)} segments")
 
 

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from . import hemodynamics as hd
-from .analysis import ValveEvents, valve_events
+from .analysis import ValveEvents, robust_peak, triangle_areas, valve_events
 from .launch import launch, read_cost
 from .report import kinematics_table
 from .run_report import free_edge_kinematics
@@ -39,6 +39,7 @@ MATERIALS = ("Ogden", "MHGO")
 STRIP_DEPTH_2D = 1.0e-3           # m; the 2D cases' solid.strip_depth (valve2d.STRIP_DEPTH)
 OPENING_WINDOW_S = 0.05           # opening peaks: the first 50 ms of the cycle
 CLOSED_FROM_S = 0.27              # closed peaks: from the reference's FSI coaptation (270 ms) on
+PEAK_WINDOWS = {"opening": (0.0, OPENING_WINDOW_S), "closed": (CLOSED_FROM_S, PERIOD_S)}
 SEVERAL_TIMES = 2.0               # "takes several times longer": at least this ratio of RVOTs
 CYCLE_TOLERANCE = 0.10            # "the second cycle differs from the first by less than 10 %"
 BALANCE_TOLERANCE = 1e-6          # interface work, fluid vs solid, relative over the cycle
@@ -146,7 +147,10 @@ def _series_end(run_dir: Path) -> float:
 
 def solid_peaks(run_dir: Path, cycle: int) -> dict:
     """Peak max-principal stress (Pa) and log strain of the cycle while opening (first 50 ms)
-    and closed (from 270 ms), from the solid's per-snapshot peaks in solid_series.h5."""
+    and closed (from 270 ms): the element maximum, from the solid's per-snapshot peaks in
+    solid_series.h5, and the robust peak (the largest over the window's field snapshots of the
+    value exceeded on 1 % of the leaflet area, analysis.robust_peak), which one element at a
+    mesh corner cannot set."""
     import h5py
     path = run_dir / "solid_series.h5"
     peaks = {}
@@ -156,12 +160,41 @@ def solid_peaks(run_dir: Path, cycle: int) -> dict:
         t = f["snapshots/time"][()] - (cycle - 1) * PERIOD_S
         stress = f["snapshots/peak_max_principal_stress"][()]
         strain = f["snapshots/peak_max_principal_log_strain"][()]
-    for name, (a, b) in (("opening", (0.0, OPENING_WINDOW_S)), ("closed", (CLOSED_FROM_S, PERIOD_S))):
+    for name, (a, b) in PEAK_WINDOWS.items():
         sel = (t >= a - 1e-12) & (t < b)
         if np.any(sel):
             i, j = np.argmax(np.where(sel, stress, -np.inf)), np.argmax(np.where(sel, strain, -np.inf))
             peaks[name] = {"stress_Pa": float(stress[i]), "stress_time_s": float(t[i]),
                            "strain": float(strain[j]), "strain_time_s": float(t[j])}
+    if (run_dir / "solid_fields.h5").exists():
+        try:
+            for name, robust in robust_solid_peaks(run_dir, cycle).items():
+                peaks.setdefault(name, {}).update(robust)
+        except (KeyError, ValueError):
+            pass  # fields without a triangle mesh: the element maxima only
+    return peaks
+
+
+def robust_solid_peaks(run_dir: Path, cycle: int) -> dict:
+    """Per window of PEAK_WINDOWS: the robust peak (analysis.robust_peak) of the max-principal
+    stress ("stress_p99_Pa") and log strain ("strain_p99") over the field snapshots in it, with
+    their cycle times."""
+    from .solid_results import SolidFields
+    fields = SolidFields(run_dir)
+    areas = triangle_areas(fields.reference_nodes, fields.triangles)
+    t = fields.times - (cycle - 1) * PERIOD_S
+    peaks = {}
+    for name, (a, b) in PEAK_WINDOWS.items():
+        indices = np.flatnonzero((t >= a - 1e-12) & (t < b))
+        snapshots = [fields.snapshot(int(k)) for k in indices]
+        entry = {}
+        for quantity, key in (("max_principal_stress", "stress_p99_Pa"), ("max_principal_log_strain", "strain_p99")):
+            history = [s[quantity] for s in snapshots if quantity in s]
+            if len(history) == len(indices) and history:
+                value, k = robust_peak(history, areas)
+                entry[key], entry[key.replace("_Pa", "") + "_time_s"] = value, float(t[indices[k]])
+        if entry:
+            peaks[name] = entry
     return peaks
 
 
@@ -369,9 +402,16 @@ def check_findings(runs: dict) -> list[Finding]:
     parts, verdict = [], None
     for kind in ("FSI", "FE"):
         o, h = runs.get(f"{kind}-Ogden"), runs.get(f"{kind}-MHGO")
-        if o and h and "closed" in o.peaks and "closed" in h.peaks:
-            so, sh = o.peaks["closed"]["stress_Pa"], h.peaks["closed"]["stress_Pa"]
-            parts.append(f"{kind}: Ogden {so * 1e-6:.3g} MPa vs MHGO {sh * 1e-6:.3g} MPa")
+        if o and h and "stress_Pa" in o.peaks.get("closed", {}) and "stress_Pa" in h.peaks.get("closed", {}):
+            co, ch = o.peaks["closed"], h.peaks["closed"]
+            # judged on the robust peak where both runs have field snapshots: the element maximum
+            # sits at the fixed commissure corner, where the mesh sets its value (docs/comparison-3d.md)
+            robust = "stress_p99_Pa" in co and "stress_p99_Pa" in ch
+            so, sh = (co["stress_p99_Pa"], ch["stress_p99_Pa"]) if robust else (co["stress_Pa"], ch["stress_Pa"])
+            text = f"{kind}: Ogden {so * 1e-6:.3g} MPa vs MHGO {sh * 1e-6:.3g} MPa"
+            if robust:
+                text += f" (1 % area peak; element maximum {co['stress_Pa'] * 1e-6:.3g} vs {ch['stress_Pa'] * 1e-6:.3g})"
+            parts.append(text)
             if kind == "FSI":
                 verdict = so > sh
     if any(r.spec.dimension == 2 for r in runs.values()):
@@ -593,14 +633,20 @@ def write_report(runs: dict, out: Path, command: str, cycle: int, dimension: int
     if problems:
         lines += ["Not measured: " + "; ".join(problems), ""]
     lines += ["## Peak max-principal stress and log strain (reference Sec. 3.2)", "",
-              "| run | opening stress (MPa) | opening strain | closed stress (MPa) | closed strain |", "|---|---|---|---|---|"]
+              "| run | opening stress (MPa): max / 1 % area | opening strain: max / 1 % area | "
+              "closed stress (MPa): max / 1 % area | closed strain: max / 1 % area |", "|---|---|---|---|---|"]
+
+    def pair(entry: dict, key: str, robust_key: str, scale: float = 1.0) -> str:
+        return f"{_fmt(entry.get(key), 3, scale)} / {_fmt(entry.get(robust_key), 3, scale)}"
     for label, r in runs.items():
         o, c = r.peaks.get("opening", {}), r.peaks.get("closed", {})
-        lines.append(f"| {label} | {_fmt(o.get('stress_Pa'), 3, 1e-6)} | {_fmt(o.get('strain'), 3)} | "
-                     f"{_fmt(c.get('stress_Pa'), 3, 1e-6)} | {_fmt(c.get('strain'), 3)} |")
+        lines.append(f"| {label} | {pair(o, 'stress_Pa', 'stress_p99_Pa', 1e-6)} | {pair(o, 'strain', 'strain_p99')} | "
+                     f"{pair(c, 'stress_Pa', 'stress_p99_Pa', 1e-6)} | {pair(c, 'strain', 'strain_p99')} |")
     lines += ["| reference | – | FE-MHGO 0.22, FSI-MHGO 0.112 | FSI-Ogden 1.42, FSI-MHGO 1.13 (commissure) | MHGO 0.185, FSI-Ogden 0.144 |", "",
               f"Opening: the first {OPENING_WINDOW_S * 1e3:.0f} ms of the cycle; closed: from {CLOSED_FROM_S * 1e3:.0f} ms "
-              "to the cycle's end (the solid's per-snapshot peaks).", ""]
+              "to the cycle's end. Max: the largest element value (the solid's per-snapshot peaks); 1 % area: the "
+              "largest over the field snapshots of the value exceeded on 1 % of the leaflet's area, which one "
+              "element at a mesh corner cannot set (the \"stress\" finding is judged on it).", ""]
     lines += ["## Interface balance (issue 7, item 5)", "",
               f"Over cycle {cycle} (or the part a partial run covers): the work the fluid gave at the velocity its points "
               "moved with (Σ power_fluid·Δt) and the same through the mapping on the solid's side (Σ power_solid·Δt); "

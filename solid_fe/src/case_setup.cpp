@@ -116,6 +116,14 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
     throw CaseError(fmt::format("{}: field 'solid.time_integration' = {} with solid.element_family = "
                                 "HEXAHEDRON: allowed only for SHELL (no brick tangent yet)", source, integration));
   }
+  if (solid.has_leaflet_contact_damping_ratio() && solid.leaflet_contact_damping_ratio() > 0.0 &&
+      (bricks || solid.disable_leaflet_contact())) {
+    throw CaseError(fmt::format("{}: field 'solid.leaflet_contact_damping_ratio' = {} with {}: it damps the "
+                                "leaflet-leaflet contact pairs; allowed > 0 only for SHELL elements with leaflet "
+                                "contact on (0 otherwise)",
+                                source, solid.leaflet_contact_damping_ratio(),
+                                bricks ? "solid.element_family = HEXAHEDRON" : "solid.disable_leaflet_contact = true"));
+  }
   if (solid.leaflet_self_contact() && (bricks || solid.disable_leaflet_contact())) {
     throw CaseError(fmt::format("{}: field 'solid.leaflet_self_contact' = true with {}: allowed only for SHELL "
                                 "elements with leaflet contact on", source,
@@ -181,6 +189,7 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.max_energy_balance_error = solid.max_energy_balance_error();
   solver_options.fixed_time_step = solid.forced_time_step();
   solver_options.time_step_look_ahead = solid.time_step_look_ahead();
+  solver_options.contact_damping_ratio = solid.leaflet_contact_damping_ratio();
   if (solid.has_implicit_tangent_cost() && solid.time_integration() != cases::SolidCase::AUTOMATIC) {
     throw CaseError(fmt::format("{}: field 'solid.implicit_tangent_cost' = {} with solid.time_integration = {}: "
                                 "it prices the automatic switch's implicit steps; allowed only with "

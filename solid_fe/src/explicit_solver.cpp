@@ -38,6 +38,10 @@ ExplicitSolver::ExplicitSolver(std::unique_ptr<ElementModel> elements, SolverOpt
     throw std::invalid_argument(fmt::format(
         "solid: time_step_safety = {}: allowed (0, 1]", options_.time_step_safety));
   }
+  if (!(options_.contact_damping_ratio >= 0.0 && options_.contact_damping_ratio <= 1.0)) {
+    throw std::invalid_argument(fmt::format(
+        "solid: contact_damping_ratio = {}: allowed [0, 1]", options_.contact_damping_ratio));
+  }
   if (options_.time_step_update_interval < 1) {
     throw std::invalid_argument(fmt::format(
         "solid: time_step_update_interval = {}: allowed >= 1", options_.time_step_update_interval));
@@ -268,9 +272,12 @@ void ExplicitSolver::compute_contact_force() {
   }
   if (leaflet_contact_) {
     if (implicit_) own_contact_force_ = f;  // the tangent's per-node springs (implicit_dynamics.cpp)
-    state_.nodes_in_contact +=
-        leaflet_contact_->add_forces(*elements_->contact_surface(), x, options_.contact_stiffness_factor * omega2, f,
-                                     state_.contact_candidates);
+    // The pairs' dashpots read the velocity of the step the forces belong to: explicit steps the
+    // half-step velocity v(n - 1/2) (lagged, as explicit codes take their contact damping),
+    // Newton's iterations the trial velocity (implicit_step sets it there).
+    state_.nodes_in_contact += leaflet_contact_->add_forces(
+        *elements_->contact_surface(), x, options_.contact_stiffness_factor * omega2, f, state_.contact_candidates,
+        &state_.half_step_velocity, options_.contact_damping_ratio);
   }
 }
 

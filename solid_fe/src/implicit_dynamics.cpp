@@ -125,6 +125,9 @@ bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_force
   for (int iteration = 0;; ++iteration) {
     state_.position = x_n + w.dx;
     state_.time = t_new;
+    w.a = (w.dx - h * v_n - h * h * (0.5 - p.beta) * a_n) / (p.beta * h * h);
+    w.v = v_n + h * ((1.0 - p.gamma) * a_n + p.gamma * w.a);
+    if (options_.contact_damping_ratio > 0.0) state_.half_step_velocity = w.v;  // the contact dashpots' velocity
     w.pending_work += 1.0;  // one force evaluation, as an explicit step
     try {
       compute_internal_force(false);
@@ -133,8 +136,6 @@ bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_force
     } catch (const MaterialStateError&) {
       return fail();  // a trial state the material cannot take: a smaller step will not go there
     }
-    w.a = (w.dx - h * v_n - h * h * (0.5 - p.beta) * a_n) / (p.beta * h * h);
-    w.v = v_n + h * ((1.0 - p.gamma) * a_n + p.gamma * w.a);
     w.net = state_.external_force + state_.contact_force - state_.internal_force;
     // Inertia (and mass damping) at n+1-alpha_m (n+1-alpha_f) against the forces at n+1-alpha_f.
     w.r = ((1.0 - p.alpha_m) * w.a + p.alpha_m * a_n + damping * ((1.0 - p.alpha_f) * w.v + p.alpha_f * v_n))
@@ -227,6 +228,16 @@ bool ExplicitSolver::factorise_tangent(double h, double t_new, double mass_coeff
       leaflet_contact_->add_tangent(*elements_->contact_surface(), state_.position, penalty, state_.contact_candidates,
                                     w.blocks);
       for (const auto& b : w.blocks) add_block(b.row, b.col, stiffness_coefficient * b.k);
+      if (options_.contact_damping_ratio > 0.0) {
+        // The pairs' dashpots through the trial velocity: d(v)/d(x) = gamma / (beta h).
+        const AlphaParameters p = alpha_parameters(options_.spectral_radius_infinity);
+        w.blocks.clear();
+        leaflet_contact_->add_damping_tangent(*elements_->contact_surface(), state_.position, penalty,
+                                              options_.contact_damping_ratio,
+                                              stiffness_coefficient * p.gamma / (p.beta * h), state_.contact_candidates,
+                                              w.blocks);
+        for (const auto& b : w.blocks) add_block(b.row, b.col, b.k);
+      }
     }
     w.matrix.resize(3 * n, 3 * n);
     w.matrix.setFromTriplets(w.triplets.begin(), w.triplets.end());

@@ -104,20 +104,45 @@ void LeafletContact::rebuild(const ShellModel& model, const Eigen::Matrix3Xd& x,
   ++candidates.rebuilds;
 }
 
+double LeafletContact::pair_mass(double m_node, const Eigen::Vector3d& w, const Eigen::Vector3d& triangle_masses) {
+  return 1.0 / (1.0 / m_node + w.cwiseAbs2().cwiseQuotient(triangle_masses).sum());
+}
+
+namespace {
+// The dashpot of node i against triangle `el` at weights w: 2 ratio sqrt(k m_pair).
+double pair_damping(const ShellModel& model, std::int32_t i, const ShellElement& el, const Eigen::Vector3d& w,
+                    double k, double damping_ratio) {
+  const Eigen::Vector3d masses(model.nodal_mass(el.nodes[0]), model.nodal_mass(el.nodes[1]),
+                               model.nodal_mass(el.nodes[2]));
+  return 2.0 * damping_ratio * std::sqrt(k * LeafletContact::pair_mass(model.nodal_mass(i), w, masses));
+}
+}  // namespace
+
 std::int64_t LeafletContact::add_forces(const ShellModel& model, const Eigen::Matrix3Xd& x,
                                         double stiffness_per_mass, Eigen::Matrix3Xd& forces,
-                                        ContactCandidates& candidates) const {
+                                        ContactCandidates& candidates, const Eigen::Matrix3Xd* velocity,
+                                        double damping_ratio) const {
   if (candidates.positions_at_build.cols() != x.cols() ||
       (x - candidates.positions_at_build).colwise().norm().maxCoeff() > 0.5 * margin_) {
     rebuild(model, x, candidates);
   }
+  const bool damped = velocity != nullptr && damping_ratio > 0.0;
   std::int64_t in_contact = 0;
   Eigen::Vector3d w, direction;
   for (const auto& [i, e] : candidates.pairs) {
     const double g = gap(model, x, i, e, direction, w);
     if (g >= 0.0) continue;
     const ShellElement& el = model.elements[static_cast<std::size_t>(e)];
-    const Eigen::Vector3d f = -stiffness_per_mass * model.nodal_mass(i) * g * direction;
+    const double k = stiffness_per_mass * model.nodal_mass(i);
+    double normal_force = -k * g;
+    if (damped) {
+      const double c = pair_damping(model, i, el, w, k, damping_ratio);
+      const Eigen::Vector3d relative = velocity->col(i) - (w(0) * velocity->col(el.nodes[0]) +
+                                                           w(1) * velocity->col(el.nodes[1]) +
+                                                           w(2) * velocity->col(el.nodes[2]));
+      normal_force = std::max(0.0, normal_force - c * relative.dot(direction));
+    }
+    const Eigen::Vector3d f = normal_force * direction;
     forces.col(i) += f;
     for (int a = 0; a < 3; ++a) forces.col(el.nodes[a]) -= w(a) * f;
     ++in_contact;
@@ -189,6 +214,25 @@ void LeafletContact::add_tangent(const ShellModel& model, const Eigen::Matrix3Xd
         blocks.push_back({nodes[static_cast<std::size_t>(a)], nodes[static_cast<std::size_t>(b)],
                           stiffness.block<3, 3>(3 * a, 3 * b)});
       }
+    }
+  }
+}
+
+void LeafletContact::add_damping_tangent(const ShellModel& model, const Eigen::Matrix3Xd& x, double stiffness_per_mass,
+                                         double damping_ratio, double scale, const ContactCandidates& candidates,
+                                         std::vector<NodeBlock>& blocks) const {
+  if (!(damping_ratio > 0.0)) return;
+  Eigen::Vector3d w, direction;
+  for (const auto& [i, e] : candidates.pairs) {
+    const double g = gap(model, x, i, e, direction, w);
+    if (g >= 0.0) continue;
+    const ShellElement& el = model.elements[static_cast<std::size_t>(e)];
+    const double c = pair_damping(model, i, el, w, stiffness_per_mass * model.nodal_mass(i), damping_ratio);
+    const std::array<std::int32_t, 4> nodes{i, el.nodes[0], el.nodes[1], el.nodes[2]};
+    const std::array<double, 4> sign{1.0, -w(0), -w(1), -w(2)};
+    const Eigen::Matrix3d nn = (scale * c) * (direction * direction.transpose());
+    for (std::size_t a = 0; a < 4; ++a) {
+      for (std::size_t b = 0; b < 4; ++b) blocks.push_back({nodes[a], nodes[b], (sign[a] * sign[b]) * nn});
     }
   }
 }

@@ -155,6 +155,26 @@ TEST(CaseSetup, LeafletSelfContactIsReadAndRefusedForBricks) {
   }
 }
 
+TEST(CaseSetup, LeafletContactDampingIsReadAndRefusedWithoutLeafletContact) {
+  const CaseFiles f = write_case("contact_damping", "leaflet_self_contact: true leaflet_contact_damping_ratio: 0.3");
+  EXPECT_EQ(setup_from_case(load_case(f.case_file), f.case_file).solver->options().contact_damping_ratio, 0.3);
+  const CaseFiles plain = write_case("no_contact_damping", "");
+  EXPECT_EQ(setup_from_case(load_case(plain.case_file), plain.case_file).solver->options().contact_damping_ratio, 0.0);
+  for (const char* without : {"disable_leaflet_contact: true", "element_family: HEXAHEDRON"}) {
+    const CaseFiles bad = write_case("contact_damping_without_contact",
+                                     std::string("leaflet_contact_damping_ratio: 0.3 ") + without);
+    try {
+      setup_from_case(load_case(bad.case_file), bad.case_file);
+      FAIL() << "damping of a leaflet contact that is off must be refused (" << without << ")";
+    } catch (const CaseError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("solid.leaflet_contact_damping_ratio"), std::string::npos) << what;
+      EXPECT_NE(what.find("0.3"), std::string::npos) << "names the value: " << what;
+      EXPECT_NE(what.find("SHELL"), std::string::npos) << "names what is allowed: " << what;
+    }
+  }
+}
+
 TEST(CaseSetup, UnknownNodeSetIsNamed) {
   const CaseFiles f = write_case("bad", "fixed_node_sets: \"nope\"");
   const cases::Case c = load_case(f.case_file);

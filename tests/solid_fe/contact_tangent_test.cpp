@@ -17,46 +17,8 @@ namespace {
 
 constexpr double kThickness = 0.25e-3;
 
-// Two 6 x 4 mm sheets of nx x ny cells, the upper one shifted in-plane by a fraction of a cell (its nodes meet the
-// lower one's triangle faces, edges and corners) and lifted by `lift`; left and right edges held.
-struct TwoSheets {
-  Mesh mesh;
-  std::vector<int> surface;                 // 0 lower, 1 upper
-  std::vector<std::int64_t> upper_elements;
-  std::vector<std::int64_t> fixed;
-};
-
-TwoSheets two_sheets(double lift, int nx, int ny) {
-  const Mesh lower = testing::rectangular_plate(6e-3, 4e-3, nx, ny, kThickness);
-  Mesh upper = testing::rectangular_plate(6e-3, 4e-3, nx, ny, kThickness, true);
-  upper.nodes.row(0).array() += 0.23e-3;
-  upper.nodes.row(1).array() += 0.17e-3;
-  upper.nodes.row(2).array() += lift;
-  TwoSheets s;
-  Mesh& m = s.mesh;
-  const Eigen::Index n = lower.num_nodes();
-  m.nodes.resize(3, 2 * n);
-  m.nodes << lower.nodes, upper.nodes;
-  m.triangles = lower.triangles;
-  for (auto t : upper.triangles) {
-    for (auto& a : t) a += n;
-    m.triangles.push_back(t);
-  }
-  m.triangle_thickness.assign(m.triangles.size(), kThickness);
-  const auto t = static_cast<Eigen::Index>(m.triangles.size());
-  m.triangle_circumferential = Eigen::Vector3d::UnitX().replicate(1, t);
-  m.triangle_radial = Eigen::Vector3d::UnitY().replicate(1, t);
-  s.surface.assign(static_cast<std::size_t>(2 * n), 0);
-  std::fill(s.surface.begin() + n, s.surface.end(), 1);
-  for (std::int64_t e = lower.num_triangles(); e < t; ++e) s.upper_elements.push_back(e);
-  for (const char* side : {"left", "right"}) {
-    for (const auto a : lower.node_sets.at(side)) {
-      s.fixed.push_back(a);
-      s.fixed.push_back(a + n);
-    }
-  }
-  return s;
-}
+using testing::two_sheets;
+using testing::TwoSheets;
 
 Eigen::VectorXd flat(const Eigen::Matrix3Xd& m) { return Eigen::Map<const Eigen::VectorXd>(m.data(), m.size()); }
 

@@ -59,6 +59,47 @@ inline Mesh rectangular_plate(double lx, double ly, int nx, int ny, double thick
   return m;
 }
 
+// Two 6 x 4 mm sheets (leaflets 0 and 1) of nx x ny cells, the upper one shifted in-plane by a fraction of a cell (its nodes meet the
+// lower one's triangle faces, edges and corners) and lifted by `lift`; left and right edges held.
+struct TwoSheets {
+  Mesh mesh;
+  std::vector<int> surface;                 // 0 lower, 1 upper
+  std::vector<std::int64_t> upper_elements;
+  std::vector<std::int64_t> fixed;
+};
+
+inline TwoSheets two_sheets(double lift, int nx, int ny, double thickness = 0.25e-3) {
+  const Mesh lower = testing::rectangular_plate(6e-3, 4e-3, nx, ny, thickness);
+  Mesh upper = testing::rectangular_plate(6e-3, 4e-3, nx, ny, thickness, true);
+  upper.nodes.row(0).array() += 0.23e-3;
+  upper.nodes.row(1).array() += 0.17e-3;
+  upper.nodes.row(2).array() += lift;
+  TwoSheets s;
+  Mesh& m = s.mesh;
+  const Eigen::Index n = lower.num_nodes();
+  m.nodes.resize(3, 2 * n);
+  m.nodes << lower.nodes, upper.nodes;
+  m.triangles = lower.triangles;
+  for (auto t : upper.triangles) {
+    for (auto& a : t) a += n;
+    m.triangles.push_back(t);
+  }
+  m.triangle_thickness.assign(m.triangles.size(), thickness);
+  const auto t = static_cast<Eigen::Index>(m.triangles.size());
+  m.triangle_circumferential = Eigen::Vector3d::UnitX().replicate(1, t);
+  m.triangle_radial = Eigen::Vector3d::UnitY().replicate(1, t);
+  s.surface.assign(static_cast<std::size_t>(2 * n), 0);
+  std::fill(s.surface.begin() + n, s.surface.end(), 1);
+  for (std::int64_t e = lower.num_triangles(); e < t; ++e) s.upper_elements.push_back(e);
+  for (const char* side : {"left", "right"}) {
+    for (const auto a : lower.node_sets.at(side)) {
+      s.fixed.push_back(a);
+      s.fixed.push_back(a + n);
+    }
+  }
+  return s;
+}
+
 // The pressed flap's step control (docs/solid_fe.md, "The pressed flap"): calibration every 2000
 // steps, growth 0.2 % per step, look-ahead 2 steps, mass damping 300/s (it settles in ~25 ms).
 inline SolverOptions pressed_flap_options() {

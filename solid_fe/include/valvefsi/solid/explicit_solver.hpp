@@ -153,6 +153,11 @@ enum class TimeIntegration {
 
 struct SolverOptions {
   double contact_stiffness_factor = 0.1;  // penalty k = factor * m * omega_max^2 per node
+  // Leaflet-leaflet pairs in contact: a normal dashpot at this fraction of the critical damping
+  // of the pair's penalty spring (2 sqrt(k m_pair)), on the closing speed; 0 = none. Explicit
+  // steps read the half-step velocity v(n - 1/2), implicit ones the trial velocity. Case field
+  // solid.leaflet_contact_damping_ratio (docs/solid_fe.md, "Sixteenth session").
+  double contact_damping_ratio = 0.0;
   double time_step_safety = 0.8;        // fraction of the estimated critical step
   double mass_damping_per_s = 0.0;      // alpha of the damping force alpha m v (off when 0)
   int time_step_update_interval = 10;   // re-estimate the stable step every this many steps

@@ -47,11 +47,20 @@ class LeafletContact {
   LeafletContact(const ShellModel& model, std::vector<int> surface_of_node, bool self_contact = false);
   bool self_contact() const { return self_contact_; }
 
-  // Adds the penalty forces k * penetration (k = stiffness_per_mass * nodal mass) to `forces`,
-  // rebuilding `candidates` when some node moved more than half the margin; returns the number
-  // of node-triangle pairs in contact.
+  // Adds the penalty forces k * penetration (k = stiffness_per_mass * nodal mass of the pair's
+  // node) to `forces`, rebuilding `candidates` when some node moved more than half the margin;
+  // returns the number of node-triangle pairs in contact. With a `velocity` (3 x nodes) and
+  // damping_ratio > 0 each pair in contact also gets a normal dashpot c = 2 damping_ratio
+  // sqrt(k m_pair) on the closing speed of the node and the triangle's closest point (m_pair:
+  // the pair's reduced mass, pair_mass), the pair's normal force kept >= 0 (no adhesion):
+  // docs/solid_fe.md, "Sixteenth session".
   std::int64_t add_forces(const ShellModel& model, const Eigen::Matrix3Xd& x, double stiffness_per_mass,
-                          Eigen::Matrix3Xd& forces, ContactCandidates& candidates) const;
+                          Eigen::Matrix3Xd& forces, ContactCandidates& candidates,
+                          const Eigen::Matrix3Xd* velocity = nullptr, double damping_ratio = 0.0) const;
+  // Reduced mass of a node of mass m_node against the point of a triangle with barycentric
+  // weights w (lumped masses m_a): 1 / (1/m_node + sum w_a^2 / m_a), the mass a normal force
+  // between them accelerates apart.
+  static double pair_mass(double m_node, const Eigen::Vector3d& w, const Eigen::Vector3d& triangle_masses);
   // Energy stored in the penalties at x over the current candidates: sum of k g^2 / 2 (J), the
   // potential whose gradient add_forces applies (for the ledger's check).
   double penalty_energy(const ShellModel& model, const Eigen::Matrix3Xd& x, double stiffness_per_mass,
@@ -61,6 +70,13 @@ class LeafletContact {
   // node and the triangle's three nodes, with the gap's geometry (closest point, normal).
   void add_tangent(const ShellModel& model, const Eigen::Matrix3Xd& x, double stiffness_per_mass,
                    const ContactCandidates& candidates, std::vector<NodeBlock>& blocks) const;
+  // The dashpots' damping matrix -d(force)/d(velocity) at x (damping_ratio > 0): per pair in
+  // contact c (1, -w)(1, -w)^T (x) n n^T over the node and the triangle's three nodes, each block
+  // times `scale` (the implicit scheme's d(velocity)/d(position)). The normal's and weights' turn
+  // under the dashpot force is left out (an approximate tangent: the dashpot force is small).
+  void add_damping_tangent(const ShellModel& model, const Eigen::Matrix3Xd& x, double stiffness_per_mass,
+                           double damping_ratio, double scale, const ContactCandidates& candidates,
+                           std::vector<NodeBlock>& blocks) const;
 
  private:
   void rebuild(const ShellModel& model, const Eigen::Matrix3Xd& x, ContactCandidates& candidates) const;

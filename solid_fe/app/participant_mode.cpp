@@ -91,6 +91,7 @@ coupling::InterfaceSurfaceData surface_data(const SolidInterface& s) {
 int run_participant(const cases::Case& c, const std::filesystem::path& case_file,
                     const std::filesystem::path& output_dir) {
   const auto wall_start = Clock::now();
+  check_coupled_solid_case(c, case_file);
   SolidSetup setup = setup_from_case(c, case_file);
   for (const auto& note : setup.notes) spdlog::info("{}", note);
   ExplicitSolver& solver = *setup.solver;

@@ -96,6 +96,16 @@ const std::vector<std::int64_t>& node_set(const Mesh& mesh, const std::string& n
 
 }  // namespace
 
+void check_coupled_solid_case(const cases::Case& c, const std::filesystem::path& case_file) {
+  if (c.solid().diastolic_mass_damping_per_s() > 0.0) {
+    throw CaseError(fmt::format("{}: field 'solid.diastolic_mass_damping_per_s' = {} in a coupled run: it stands in "
+                                "for the blood's damping of the closed valve under the FE-only pressure waveform; "
+                                "allowed > 0 only in FE-only runs (solid_fe --fe-only or run.fe_only: true), 0 when "
+                                "coupled (the fluid damps the valve)",
+                                case_file.string(), c.solid().diastolic_mass_damping_per_s()));
+  }
+}
+
 SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& case_file) {
   const std::string source = case_file.string();
   if (!c.has_solid()) {
@@ -190,6 +200,7 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.fixed_time_step = solid.forced_time_step();
   solver_options.time_step_look_ahead = solid.time_step_look_ahead();
   solver_options.contact_damping_ratio = solid.leaflet_contact_damping_ratio();
+  solver_options.diastolic_mass_damping_per_s = solid.diastolic_mass_damping_per_s();
   if (solid.has_implicit_tangent_cost() && solid.time_integration() != cases::SolidCase::AUTOMATIC) {
     throw CaseError(fmt::format("{}: field 'solid.implicit_tangent_cost' = {} with solid.time_integration = {}: "
                                 "it prices the automatic switch's implicit steps; allowed only with "
@@ -248,6 +259,12 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
 
   if (solver_options.mass_damping_per_s > 0.0) {
     setup.notes.push_back(fmt::format("mass-proportional damping ON: alpha = {} 1/s", solver_options.mass_damping_per_s));
+  }
+  if (solver_options.diastolic_mass_damping_per_s > 0.0) {
+    setup.notes.push_back(fmt::format("diastolic mass-proportional damping ON: alpha = {} 1/s while the transvalvular "
+                                      "pressure is negative (valve loaded closed), {} 1/s otherwise "
+                                      "(solid.diastolic_mass_damping_per_s)",
+                                      solver_options.diastolic_mass_damping_per_s, solver_options.mass_damping_per_s));
   }
   if (bricks) {
     HexahedronModelOptions brick_options;

@@ -508,7 +508,6 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
     }
   }
   const Eigen::ArrayXd inverse_mass = elements_->nodal_mass().array().inverse();
-  const double alpha = options_.mass_damping_per_s;
   Eigen::Matrix3Xd& x = state_.position;
   Eigen::Matrix3Xd& v_half = state_.half_step_velocity;
   Eigen::Matrix3Xd& a = acceleration_;
@@ -554,6 +553,8 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
       dt = 0.5 * remaining;
     }
     const double averaged_step = 0.5 * (state_.last_step + dt);
+    // The damping force at t_n (this step's start), where the pressure's sign is read.
+    const double alpha = mass_damping_at(state_.time);
     if (alpha > 0.0) {
       // Central difference with damping force alpha m v at the full step, v the mean of the
       // two half-step velocities (implicit in v).
@@ -611,6 +612,13 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
       drop_kept_tangent();
     }
   }
+}
+
+double ExplicitSolver::mass_damping_at(double t) const {
+  if (options_.diastolic_mass_damping_per_s > 0.0 && pressure_ && pressure_(t) < 0.0) {
+    return options_.diastolic_mass_damping_per_s;
+  }
+  return options_.mass_damping_per_s;
 }
 
 int ExplicitSolver::pressure_sign(double t) const {

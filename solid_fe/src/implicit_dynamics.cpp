@@ -36,6 +36,7 @@ struct ExplicitSolver::ImplicitWork {
   // size is the one it was built for and the residual falls fast enough with it.
   bool factor_valid = false;
   double factor_step = 0;
+  double factor_damping = 0;  // the mass damping the kept tangent was built with (it changes in diastole)
   int fast_steps = 0;  // consecutive steps converged within newton_fast_iterations
   // Cost rule: work since the last accepted step (failed tries included) in explicit-step
   // equivalents; moved into SolverState::block_work when a step is accepted.
@@ -95,7 +96,7 @@ bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_force
   ImplicitWork& w = *implicit_;
   const AlphaParameters p = alpha_parameters(options_.spectral_radius_infinity);
   const Eigen::ArrayXd mass = elements_->nodal_mass().array();
-  const double damping = options_.mass_damping_per_s;
+  const double damping = mass_damping_at(state_.time);  // the step's, read at its start
   const SolverState start = state_;  // restored when Newton fails
   const Eigen::Matrix3Xd& x_n = start.position;
   const Eigen::Matrix3Xd& v_n = start.velocity;
@@ -160,10 +161,13 @@ bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_force
     }
     // A kept tangent is refreshed when it was built for another step size or when the residual
     // fell by less than 4x in the last iteration with it.
-    const bool refresh = !w.factor_valid || std::abs(w.factor_step - h) > 1e-9 * h ||
+    const bool refresh = !w.factor_valid || std::abs(w.factor_step - h) > 1e-9 * h || w.factor_damping != damping ||
                          (iteration > 0 && residual > 0.25 * previous_residual);
     previous_residual = residual;
-    if (refresh && !factorise_tangent(h, t_new, mass_coefficient, stiffness_coefficient)) return fail();
+    if (refresh) {
+      if (!factorise_tangent(h, t_new, mass_coefficient, stiffness_coefficient)) return fail();
+      w.factor_damping = damping;
+    }
     w.delta = w.lu.solve(-Eigen::Map<const Eigen::VectorXd>(w.r.data(), 3 * n));
     if (w.lu.info() != Eigen::Success || !w.delta.allFinite()) {
       w.factor_valid = false;
@@ -259,7 +263,7 @@ bool ExplicitSolver::factorise_tangent(double h, double t_new, double mass_coeff
 bool ExplicitSolver::finish_implicit_step(const SolverState& start, double h) {
   ImplicitWork& w = *implicit_;
   const Eigen::ArrayXd mass = elements_->nodal_mass().array();
-  const double damping = options_.mass_damping_per_s;
+  const double damping = mass_damping_at(start.time);  // as implicit_step's
   const Eigen::Matrix3Xd& v_n = start.velocity;
   const Eigen::Index n = v_n.cols();
 
@@ -331,7 +335,7 @@ void ExplicitSolver::advance_window_implicit(double t_end, const Eigen::Matrix3X
   if (state_.acceleration.cols() != n) {
     // Start (or the switch from explicit): the acceleration the equation of motion gives now.
     compute_acceleration(elements_->nodal_mass().array().inverse());
-    state_.acceleration = acceleration_ - options_.mass_damping_per_s * state_.velocity;
+    state_.acceleration = acceleration_ - mass_damping_at(state_.time) * state_.velocity;
     apply_constraints(state_.acceleration);
   }
   // Steps are max_time_step / 2^k, so that they divide output windows of that size and a kept

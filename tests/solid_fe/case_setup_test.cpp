@@ -175,6 +175,40 @@ TEST(CaseSetup, LeafletContactDampingIsReadAndRefusedWithoutLeafletContact) {
   }
 }
 
+TEST(CaseSetup, DiastolicMassDampingIsReadAnnouncedAndRefusedWhenCoupled) {
+  const CaseFiles f = write_case("diastolic", "mass_damping_per_s: 20 diastolic_mass_damping_per_s: 200");
+  const cases::Case c = load_case(f.case_file);
+  const SolidSetup setup = setup_from_case(c, f.case_file);
+  EXPECT_EQ(setup.solver->options().diastolic_mass_damping_per_s, 200.0);
+  EXPECT_EQ(setup.solver->options().mass_damping_per_s, 20.0);
+  bool announced = false;
+  for (const auto& note : setup.notes) announced |= note.find("diastolic mass-proportional damping ON") != std::string::npos;
+  EXPECT_TRUE(announced) << "the start notes say the option is on";
+  const CaseFiles plain = write_case("no_diastolic", "");
+  EXPECT_EQ(setup_from_case(load_case(plain.case_file), plain.case_file).solver->options().diastolic_mass_damping_per_s,
+            0.0);
+  EXPECT_NO_THROW(check_coupled_solid_case(load_case(plain.case_file), plain.case_file)) << "off: allowed when coupled";
+  try {
+    check_coupled_solid_case(c, f.case_file);
+    FAIL() << "a coupled run must refuse the FE-only diastolic damping";
+  } catch (const CaseError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(f.case_file.string()), std::string::npos) << "names the case file: " << what;
+    EXPECT_NE(what.find("solid.diastolic_mass_damping_per_s"), std::string::npos) << what;
+    EXPECT_NE(what.find("200"), std::string::npos) << "names the value: " << what;
+    EXPECT_NE(what.find("FE-only"), std::string::npos) << "names what is allowed: " << what;
+  }
+  const CaseFiles negative = write_case("diastolic_negative", "diastolic_mass_damping_per_s: -5");
+  try {
+    setup_from_case(load_case(negative.case_file), negative.case_file);
+    FAIL() << "a negative damping must be refused";
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("diastolic_mass_damping_per_s"), std::string::npos) << what;
+    EXPECT_NE(what.find("-5"), std::string::npos) << "names the value: " << what;
+  }
+}
+
 TEST(CaseSetup, UnknownNodeSetIsNamed) {
   const CaseFiles f = write_case("bad", "fixed_node_sets: \"nope\"");
   const cases::Case c = load_case(f.case_file);

@@ -68,5 +68,16 @@ TEST(SolidProgram, MissingNodeSetIsReported) {
   EXPECT_NE(log_of(dir).find("solid.fixed_node_sets"), std::string::npos) << log_of(dir);
 }
 
+TEST(SolidProgram, DiastolicDampingIsRefusedInACoupledRun) {
+  // Without --fe-only (and run.fe_only) solid_fe is the coupler's participant: the FE-only
+  // option is refused before it connects.
+  const auto dir = prepare("diastolic_coupled", "", "diastolic_mass_damping_per_s: 200");
+  EXPECT_EQ(run(dir, ""), 2);
+  EXPECT_NE(log_of(dir).find("solid.diastolic_mass_damping_per_s"), std::string::npos) << log_of(dir);
+  const auto fe_only = prepare("diastolic_fe_only", "", "diastolic_mass_damping_per_s: 200");
+  EXPECT_EQ(run(fe_only, "--fe-only"), 0) << log_of(fe_only);
+  EXPECT_NE(log_of(fe_only).find("diastolic mass-proportional damping ON"), std::string::npos) << log_of(fe_only);
+}
+
 }  // namespace
 }  // namespace valvefsi::solid

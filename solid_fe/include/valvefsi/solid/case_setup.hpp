@@ -57,4 +57,8 @@ SolidMaterial solid_material_from_case(const cases::SolidCase& solid, const std:
 // std::runtime_error / std::invalid_argument (bad mesh file).
 SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& case_file);
 
+// Coupled (participant) runs: refuses (CaseError naming the case file, the field, its value and
+// what is allowed) the FE-only fields, solid.diastolic_mass_damping_per_s > 0.
+void check_coupled_solid_case(const cases::Case& c, const std::filesystem::path& case_file);
+
 }  // namespace valvefsi::solid

@@ -160,6 +160,10 @@ struct SolverOptions {
   double contact_damping_ratio = 0.0;
   double time_step_safety = 0.8;        // fraction of the estimated critical step
   double mass_damping_per_s = 0.0;      // alpha of the damping force alpha m v (off when 0)
+  // > 0: alpha while the pressure waveform is negative (the valve loaded closed), in place of
+  // mass_damping_per_s; no waveform (coupled runs): unused. Case field
+  // solid.diastolic_mass_damping_per_s (docs/solid_fe.md, "Sixteenth session (b)").
+  double diastolic_mass_damping_per_s = 0.0;
   int time_step_update_interval = 10;   // re-estimate the stable step every this many steps
   double max_time_step = 1e-4;          // upper bound on dt (s)
   // Every this many steps (or when the element estimate falls below 70 % of its value then) the
@@ -283,6 +287,9 @@ class ExplicitSolver {
   }
   const ElementModel& elements() const { return *elements_; }
   const SolverOptions& options() const { return options_; }
+  // The mass-proportional damping alpha (1/s) of a step starting at t: diastolic_mass_damping_per_s
+  // when that is > 0 and the pressure waveform is negative at t, else mass_damping_per_s.
+  double mass_damping_at(double t) const;
   Eigen::Matrix3Xd displacement() const { return state_.position - elements_->reference_positions(); }
 
   // Per-element maximum principal Cauchy stress (Pa) and logarithmic strain of the state.

@@ -14,52 +14,16 @@ points (run_case.py --restart) and joined by valve_scene.join_segments. So:
 - without it, all four are run here from scratch.
 """
 import os
-import sys
-import tempfile
 import unittest
-from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[2]
-BUILD = Path(os.environ.get("VALVEFSI_BUILD_DIR", REPO / "build"))
-CYCLE = int(os.environ.get("VALVEFSI_COMPARISON_3D_CYCLE", "1"))
+from comparison_findings import ComparisonFindings
 
 
-class ComparisonFindings3D(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        sys.path.insert(0, str(REPO / "scripts"))
-        from valve_scene import comparison
-        cls.comparison = comparison
-        cls.tmp = tempfile.TemporaryDirectory(prefix="comparison-3d-validation-")
-        runs_dir = Path(os.environ.get("VALVEFSI_COMPARISON_3D_RUNS", Path(cls.tmp.name) / "runs"))
-        out = Path(cls.tmp.name) / "report" / "comparison-3d.md"
-        out.parent.mkdir(parents=True)
-        cls.runs = comparison.compare(3, "coarse", "sector", runs_dir, BUILD, out, cycle=CYCLE, end_time=None,
-                                      reuse=True, command="test_comparison_validation_3d")
-        cls.findings = {f.key: f for f in comparison.check_findings(cls.runs)}
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.tmp.cleanup()
-
-    def test_runs_cover_the_cycle(self):
-        for label, run in self.runs.items():
-            with self.subTest(run=label):
-                self.assertGreaterEqual(run.simulated_s, CYCLE * 0.8 - 1e-6)
-                self.assertFalse(run.partial)
-
-    def test_findings_hold(self):
-        keys = ["opening", "wider", "water_hammer", "stress", "leaks"] + (["cycles"] if CYCLE >= 2 else [])
-        for key in keys:
-            with self.subTest(finding=key):
-                self.assertTrue(self.findings[key].holds, self.findings[key].evidence)
-
-    def test_interface_mapping_balanced(self):
-        for label in ("FSI-Ogden", "FSI-MHGO"):
-            with self.subTest(run=label):
-                b = self.runs[label].balance
-                self.assertLess(b["work_relative_difference"], self.comparison.BALANCE_TOLERANCE)
-                self.assertLess(b["force_relative_difference"], self.comparison.BALANCE_TOLERANCE)
+class ComparisonFindings3D(ComparisonFindings, unittest.TestCase):
+    DIMENSION, RESOLUTION = 3, "coarse"
+    CYCLE = int(os.environ.get("VALVEFSI_COMPARISON_3D_CYCLE", "1"))
+    FINDINGS = ("opening", "wider", "water_hammer", "stress", "leaks") + (("cycles",) if CYCLE >= 2 else ())
+    RUNS_VARIABLE = "VALVEFSI_COMPARISON_3D_RUNS"
 
 
 if __name__ == "__main__":

@@ -8,6 +8,7 @@
 #include <fmt/ranges.h>
 
 #include "valvefsi/case/case_loader.hpp"
+#include "valvefsi/case/pressure_waveform.hpp"
 #include "valvefsi/solid/hexahedron_solver.hpp"
 #include "valvefsi/solid/shell_solver.hpp"
 
@@ -201,6 +202,13 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   solver_options.time_step_look_ahead = solid.time_step_look_ahead();
   solver_options.contact_damping_ratio = solid.leaflet_contact_damping_ratio();
   solver_options.diastolic_mass_damping_per_s = solid.diastolic_mass_damping_per_s();
+  solver_options.diastolic_damping_onset_Pa = solid.diastolic_damping_onset_mmhg() * kPascalPerMmHg;
+  if (solid.diastolic_damping_onset_mmhg() > 0.0 && solid.diastolic_mass_damping_per_s() <= 0.0) {
+    throw CaseError(fmt::format("{}: field 'solid.diastolic_damping_onset_mmHg' = {} without "
+                                "solid.diastolic_mass_damping_per_s > 0: it sets where that damping starts; "
+                                "set both or neither",
+                                source, solid.diastolic_damping_onset_mmhg()));
+  }
   if (solid.has_implicit_tangent_cost() && solid.time_integration() != cases::SolidCase::AUTOMATIC) {
     throw CaseError(fmt::format("{}: field 'solid.implicit_tangent_cost' = {} with solid.time_integration = {}: "
                                 "it prices the automatic switch's implicit steps; allowed only with "
@@ -262,9 +270,11 @@ SolidSetup setup_from_case(const cases::Case& c, const std::filesystem::path& ca
   }
   if (solver_options.diastolic_mass_damping_per_s > 0.0) {
     setup.notes.push_back(fmt::format("diastolic mass-proportional damping ON: alpha = {} 1/s while the transvalvular "
-                                      "pressure is negative (valve loaded closed), {} 1/s otherwise "
-                                      "(solid.diastolic_mass_damping_per_s)",
-                                      solver_options.diastolic_mass_damping_per_s, solver_options.mass_damping_per_s));
+                                      "pressure is below -{} mmHg (valve loaded closed), {} 1/s otherwise "
+                                      "(solid.diastolic_mass_damping_per_s, solid.diastolic_damping_onset_mmHg)",
+                                      solver_options.diastolic_mass_damping_per_s,
+                                      solver_options.diastolic_damping_onset_Pa / kPascalPerMmHg,
+                                      solver_options.mass_damping_per_s));
   }
   if (bricks) {
     HexahedronModelOptions brick_options;

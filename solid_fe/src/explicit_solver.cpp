@@ -615,7 +615,7 @@ void ExplicitSolver::advance_window(double t_end, const Eigen::Matrix3Xd* nodal_
 }
 
 double ExplicitSolver::mass_damping_at(double t) const {
-  if (options_.diastolic_mass_damping_per_s > 0.0 && pressure_ && pressure_(t) < 0.0) {
+  if (options_.diastolic_mass_damping_per_s > 0.0 && pressure_ && pressure_(t) < -options_.diastolic_damping_onset_Pa) {
     return options_.diastolic_mass_damping_per_s;
   }
   return options_.mass_damping_per_s;

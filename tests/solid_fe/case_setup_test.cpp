@@ -209,6 +209,29 @@ TEST(CaseSetup, DiastolicMassDampingIsReadAnnouncedAndRefusedWhenCoupled) {
   }
 }
 
+TEST(CaseSetup, DiastolicDampingOnsetIsReadInPascalAndNeedsTheDamping) {
+  const CaseFiles f =
+      write_case("diastolic_onset", "diastolic_mass_damping_per_s: 500 diastolic_damping_onset_mmHg: 20");
+  const SolidSetup setup = setup_from_case(load_case(f.case_file), f.case_file);
+  EXPECT_NEAR(setup.solver->options().diastolic_damping_onset_Pa, 20 * 133.322387415, 1e-9);
+  bool announced = false;
+  for (const auto& note : setup.notes) announced |= note.find("below -20 mmHg") != std::string::npos;
+  EXPECT_TRUE(announced) << "the start notes give the onset";
+  const CaseFiles alone = write_case("onset_alone", "diastolic_damping_onset_mmHg: 15");
+  try {
+    setup_from_case(load_case(alone.case_file), alone.case_file);
+    FAIL() << "an onset without the damping it starts must be refused";
+  } catch (const CaseError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(alone.case_file.string()), std::string::npos) << "names the case file: " << what;
+    EXPECT_NE(what.find("solid.diastolic_damping_onset_mmHg"), std::string::npos) << what;
+    EXPECT_NE(what.find("15"), std::string::npos) << "names the value: " << what;
+    EXPECT_NE(what.find("diastolic_mass_damping_per_s > 0"), std::string::npos) << "says what is needed: " << what;
+  }
+  const CaseFiles negative = write_case("onset_negative", "diastolic_mass_damping_per_s: 500 diastolic_damping_onset_mmHg: -3");
+  EXPECT_THROW(setup_from_case(load_case(negative.case_file), negative.case_file), std::exception);
+}
+
 TEST(CaseSetup, UnknownNodeSetIsNamed) {
   const CaseFiles f = write_case("bad", "fixed_node_sets: \"nope\"");
   const cases::Case c = load_case(f.case_file);

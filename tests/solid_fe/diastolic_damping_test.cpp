@@ -137,6 +137,50 @@ TEST(DiastolicDamping, ImplicitDampsOnlyWhileThePressureIsNegative) {
   check(implicit_options(), 1e-9, 1e-12, "implicit");
 }
 
+// solid.diastolic_damping_onset_mmHg: under a pressure falling linearly through zero at kReverse,
+// the damping starts only where the back pressure passes the onset (here at 7 ms): up to that
+// window the run is the plain one bit for bit (the valve's closing stays undamped), after it the
+// damping work is the diastolic one.
+TEST(DiastolicDamping, OnsetDelaysTheDampingToItsBackPressure) {
+  constexpr double kOnsetTime = 7e-3;
+  const double onset_Pa = kPressure * (kOnsetTime - kReverse) / kReverse;  // 0.4 kPressure
+  auto ramp = [](double t) { return kPressure * (1.0 - t / kReverse); };
+  auto solver_with = [&](const SolverOptions& o) {
+    auto solver = plate_solver(o);
+    solver->set_pressure(ramp);
+    return solver;
+  };
+  SolverOptions with;
+  with.mass_damping_per_s = kBase;
+  with.diastolic_mass_damping_per_s = kDiastolic;
+  with.diastolic_damping_onset_Pa = onset_Pa;
+  SolverOptions plain_options;
+  plain_options.mass_damping_per_s = kBase;
+  auto option = solver_with(with);
+  auto plain = solver_with(plain_options);
+  EXPECT_EQ(option->mass_damping_at(kReverse + 1e-4), kBase) << "negative but above the onset: undamped";
+  EXPECT_EQ(option->mass_damping_at(kOnsetTime - 1e-6), kBase);
+  EXPECT_EQ(option->mass_damping_at(kOnsetTime + 1e-6), kDiastolic);
+  for (int k = 1; k <= 7; ++k) {
+    option->advance_window(k * 1e-3);
+    plain->advance_window(k * 1e-3);
+  }
+  EXPECT_EQ(option->state().energy.damping_work, plain->state().energy.damping_work);
+  EXPECT_EQ(largest_difference(option->state().position, plain->state().position), 0.0)
+      << "up to the onset the option changes nothing";
+  const double option_at_onset = option->state().energy.damping_work;
+  const double plain_at_onset = plain->state().energy.damping_work;
+  for (int k = 8; k <= 10; ++k) {
+    option->advance_window(k * 1e-3);
+    plain->advance_window(k * 1e-3);
+  }
+  const double option_work = option->state().energy.damping_work - option_at_onset;
+  const double plain_work = plain->state().energy.damping_work - plain_at_onset;
+  std::printf("onset %.0f Pa: damping work 7-10 ms %.6g J (plain %g/s: %.6g J)\n", onset_Pa, option_work, kBase,
+              plain_work);
+  EXPECT_GT(option_work, 5.0 * plain_work) << "past the onset the damping is the diastolic one";
+}
+
 TEST(DiastolicDamping, OffWithoutAPressureWaveform) {
   // Coupled runs have no waveform (the fluid loads the leaflets): the base coefficient throughout.
   SolverOptions o;

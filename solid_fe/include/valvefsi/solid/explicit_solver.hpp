@@ -164,6 +164,9 @@ struct SolverOptions {
   // mass_damping_per_s; no waveform (coupled runs): unused. Case field
   // solid.diastolic_mass_damping_per_s (docs/solid_fe.md, "Sixteenth session (b)").
   double diastolic_mass_damping_per_s = 0.0;
+  // Back pressure (Pa, >= 0) beyond which the diastolic damping acts: it applies while the waveform
+  // is below -diastolic_damping_onset_Pa. Case field solid.diastolic_damping_onset_mmHg.
+  double diastolic_damping_onset_Pa = 0.0;
   int time_step_update_interval = 10;   // re-estimate the stable step every this many steps
   double max_time_step = 1e-4;          // upper bound on dt (s)
   // Every this many steps (or when the element estimate falls below 70 % of its value then) the
@@ -288,7 +291,8 @@ class ExplicitSolver {
   const ElementModel& elements() const { return *elements_; }
   const SolverOptions& options() const { return options_; }
   // The mass-proportional damping alpha (1/s) of a step starting at t: diastolic_mass_damping_per_s
-  // when that is > 0 and the pressure waveform is negative at t, else mass_damping_per_s.
+  // when that is > 0 and the pressure waveform is below -diastolic_damping_onset_Pa at t, else
+  // mass_damping_per_s.
   double mass_damping_at(double t) const;
   Eigen::Matrix3Xd displacement() const { return state_.position - elements_->reference_positions(); }
 

@@ -152,12 +152,23 @@ FE_ONLY_RESTART_INTERVAL_S = 0.1    # long FE-only runs survive a stop (solid_fe
 # "Twelfth session").
 FE_ONLY_SPECTRAL_RADIUS_INFINITY = 0.5
 FE_ONLY_SETTLED_FILTER_TIME_S = 1e-3
+# FE-only diastole: the follower pressure pumps the closed full valve into a flutter (kinetic 7.7 mJ
+# against 3.4 mJ strain energy at 0.3 s, 0.07-0.09 us steps, ~30 s CPU per ms); 500/s of mass damping
+# from -20 mmHg on holds it at rest (kinetic <= 5 uJ over 0.26-0.30 s) and stands in for the blood
+# that damps the closed valve. The onset lies past the closing's end (244.4 ms, -6 mmHg), so RVCT is
+# the undamped one (docs/solid_fe.md, "Seventeenth session").
+FE_ONLY_DIASTOLIC_MASS_DAMPING_PER_S = 500.0
+FE_ONLY_DIASTOLIC_DAMPING_ONSET_MMHG = 20.0
 
 
 def fe_only_damping_lines(spec: CaseSpec) -> str:
     return ("  # no blood damps the FE-only leaflet: undamped, the closed leaflet chatters and two cycles stop on\n"
             "  # energy growth at ~0.86 s; 20/s leaves the opening unchanged (docs/fe-only-study.md)\n"
             f"  mass_damping_per_s: {FE_ONLY_MASS_DAMPING_PER_S:g}\n"
+            "  # the closed valve under the follower pressure flutters unless damped like the blood would:\n"
+            "  # 500/s from -20 mmHg back pressure on, after the closing (docs/solid_fe.md)\n"
+            f"  diastolic_mass_damping_per_s: {FE_ONLY_DIASTOLIC_MASS_DAMPING_PER_S:g}\n"
+            f"  diastolic_damping_onset_mmHg: {FE_ONLY_DIASTOLIC_DAMPING_ONSET_MMHG:g}\n"
             f"  restart_interval_s: {FE_ONLY_RESTART_INTERVAL_S:g}\n"
             + (fe_only_automatic_lines() if spec.variant == "sector" else ""))
 

@@ -68,6 +68,18 @@ class CaseFiles(unittest.TestCase):
             else:
                 self.assertNotIn("max_energy_balance_error", solid)
 
+    def test_fe_only_cases_damp_the_closed_valve_from_its_onset_and_fsi_cases_do_not(self):
+        for spec in all_specs():
+            text = case_text(spec)
+            solid = text[text.index("solid {"):text.index("\n}\n", text.index("solid {")) + 1]
+            if spec.kind == "FE":
+                # past the closing's end (-6 mmHg at 244.4 ms), so RVCT stays undamped (docs/solid_fe.md)
+                self.assertIn("  diastolic_mass_damping_per_s: 500\n", solid, spec.name)
+                self.assertIn("  diastolic_damping_onset_mmHg: 20\n", solid, spec.name)
+            else:
+                # the solid program refuses it when coupled: the fluid damps the valve
+                self.assertNotIn("diastolic", solid, spec.name)
+
     def test_every_3d_case_has_the_stent_cylinder(self):
         for spec in all_specs():
             self.assertIn(f"contact_cylinders {{ origin: [0, 0, 0] axis: [0, 0, 1] radius: {stent_radius():.6g} }}", case_text(spec))

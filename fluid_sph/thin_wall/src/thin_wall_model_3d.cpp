@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -140,6 +141,80 @@ bool crosses_common(const TriangleMesh& mesh, const std::vector<std::array<Vec3,
     if (crossing(mesh, t, p, q)) return true;
   }
   return false;
+}
+
+// A candidate triangle as one particle's lattice behind one sheet sees it (add_surface_rates):
+// its corners in the lattice's frame (t1, t2, n) from the particle, and per layer the rectangle
+// of lattice offsets (i delta, j delta) whose segment from the particle can meet it.
+struct ShadowBound {
+  enum Kind : std::uint8_t { test, never, rectangle };
+  Kind kind = test;
+  std::array<double, 3> xi{}, eta{}, zeta{};
+  double spread = 1.0;                        // the corners' largest |zeta| over their smallest
+  double lo1 = 0, hi1 = 0, lo2 = 0, hi2 = 0;  // the current layer's rectangle
+
+  // Whether the segment to the layer's point at offsets (i delta, j delta) certainly misses.
+  bool misses(double offset1, double offset2) const {
+    return kind == never || (kind == rectangle && (offset1 < lo1 || offset1 > hi1 || offset2 < lo2 || offset2 > hi2));
+  }
+};
+
+// The per-sheet and per-layer set-up of the ShadowBounds (see add_surface_rates). Out of line:
+// the lattice's own arithmetic around the call is then compiled as before (the build contracts
+// a * b + c into FMAs where it sees fit, so code inlined beside it could change its last bits).
+[[gnu::noinline]] void frame_shadow_bounds(const TriangleMesh& mesh, const std::vector<std::uint32_t>& cand, const Vec3& xa,
+                                           const Vec3& t1, const Vec3& t2, const Vec3& n, double zeta_margin, double front,
+                                           std::vector<ShadowBound>& bounds) {
+  bounds.resize(cand.size());
+  for (std::size_t k = 0; k < cand.size(); ++k) {
+    ShadowBound& b = bounds[k];
+    b.kind = ShadowBound::test;
+    const auto& tri = mesh.triangles[cand[k]];
+    double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
+    for (std::size_t m = 0; m < 3; ++m) {
+      const Vec3 w = sub(mesh.position[tri[m]], xa);
+      b.xi[m] = dot(w, t1);
+      b.eta[m] = dot(w, t2);
+      b.zeta[m] = dot(w, n);
+      zmin = std::min(zmin, b.zeta[m]);
+      zmax = std::max(zmax, b.zeta[m]);
+    }
+    if (zmin >= zeta_margin) {
+      b.kind = ShadowBound::never;
+    } else if (zmax <= -front) {  // well in front: the projection stays bounded
+      b.kind = ShadowBound::rectangle;
+      b.spread = zmin / zmax;
+    }
+  }
+}
+
+[[gnu::noinline]] void layer_shadow_bounds(double level, double o1, double o2, double delta, std::vector<ShadowBound>& bounds) {
+  for (auto& b : bounds) {
+    if (b.kind != ShadowBound::rectangle) continue;
+    b.lo1 = b.lo2 = std::numeric_limits<double>::infinity();
+    b.hi1 = b.hi2 = -b.lo1;
+    double extent = 0.0;
+    for (std::size_t m = 0; m < 3; ++m) {
+      const double scale = level / b.zeta[m];
+      const double u = b.xi[m] * scale, v = b.eta[m] * scale;
+      extent = std::max({extent, std::abs(u), std::abs(v)});
+      b.lo1 = std::min(b.lo1, u - o1);
+      b.hi1 = std::max(b.hi1, u - o1);
+      b.lo2 = std::min(b.lo2, v - o2);
+      b.hi2 = std::max(b.hi2, v - o2);
+    }
+    const double margin = 1e-6 * delta + 1e-8 * b.spread * extent;
+    b.lo1 -= margin;
+    b.hi1 += margin;
+    b.lo2 -= margin;
+    b.hi2 += margin;
+  }
+}
+
+// The frame's offsets of the closest point from the particle (o1, o2, o3), out of line as above.
+[[gnu::noinline]] std::array<double, 3> frame_offsets(const Vec3& point, const Vec3& xa, const Vec3& t1, const Vec3& t2, const Vec3& n) {
+  const Vec3 to_point = sub(point, xa);
+  return {dot(to_point, t1), dot(to_point, t2), dot(to_point, n)};
 }
 
 // Fresh for every classify (of any model): tells the per-thread caches that they are stale.
@@ -729,6 +804,7 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
       std::vector<ClosestPoint3> sheets;
       std::vector<std::uint32_t> one;  // one sheet's candidates
       std::vector<std::array<Vec3, 2>> free_edges;
+      std::vector<ShadowBound> bounds;  // per candidate, for the current sheet and layer
       // The node loads are booked per block of particles and summed in block order
       // (OrderedNodeLoads): the same in every run, on any number of threads.
 #pragma omp for schedule(dynamic, 4)
@@ -813,6 +889,20 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
             const double t1l = norm(t1);
             t1 = {t1[0] / t1l, t1[1] / t1l, t1[2] / t1l};
             const Vec3 t2 = cross(n, t1);
+            // The shadow test's bounds (settings_.lattice_shadow_bounds). In the frame (t1, t2, n)
+            // from the particle, x_v - x_a = (o1 + i delta, o2 + j delta, o3 - depth): a layer's
+            // points lie in the plane zeta = o3 - depth < 0. A segment from the particle to one
+            // of them can meet a triangle only at zeta in [o3 - depth, 0], so not one whose
+            // corners all lie at zeta > 0 ("never"); and for one whose corners all lie at
+            // zeta < 0, only where the point is the central projection of a point of the
+            // triangle, inside the projected corners' bounding rectangle ("rectangle"). The
+            // margins (1e-6 delta, and 1e-8 of the rectangle's reach times the corners' depth
+            // spread) are far above round-off and the crossing test's 1e-12 tolerance, so every
+            // skipped triangle is one the exact test would not hit: the same first hit.
+            const bool use_bounds = settings_.lattice_shadow_bounds;
+            const std::array<double, 3> frame = use_bounds ? frame_offsets(c.point, xa, t1, t2, n) : std::array<double, 3>{};
+            const double zeta_margin = 1e-6 * delta;
+            if (use_bounds) frame_shadow_bounds(mesh_, cand, xa, t1, t2, n, zeta_margin, 1e-3 * delta, bounds);
             const double first_depth =
                 settings_.particle_aligned_layers ? delta - std::fmod(nl, delta) : 0.5 * delta;
             // Layers in front of the tangent plane too: on the concave side of a curved leaflet the
@@ -831,6 +921,9 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
               const double room = R * R * (1.0 + 1e-6) - along * along;
               if (room < 0.0) continue;
               const int span_i = std::min(layers, static_cast<int>(std::sqrt(room) / delta));
+              const double level = frame[2] - depth;  // the layer's zeta
+              const bool bounded = use_bounds && level <= -zeta_margin;
+              if (bounded) layer_shadow_bounds(level, frame[0], frame[1], delta, bounds);
               for (int i = -span_i; i <= span_i; ++i) {
                 const double room_i = room - (i * delta) * (i * delta);
                 if (room_i < 0.0) continue;
@@ -856,8 +949,12 @@ void ThinWallModel3D::add_surface_rates(Particles<3>& p) {
                   // Only candidates within |a x_v| of a can be met on the way (nearest first).
                   const double reach = cand_distance ? std::sqrt(r2) + reach_margin()
                                                      : std::numeric_limits<double>::infinity();
+                  const double offset1 = i * delta, offset2 = j * delta;
                   for (std::size_t k = 0; k < cand.size() && !hit; ++k) {
                     if (cand_distance && (*cand_distance)[k] > reach) break;
+                    if (bounded) {
+                      if (bounds[k].misses(offset1, offset2)) continue;
+                    }
                     const std::uint32_t t = cand[k];
                     const double sv = dot(face_normal_[t], xv) - face_offset_[t];
                     if (!may_meet(face_box_[t], side_a[k], sv, xa, xv)) continue;

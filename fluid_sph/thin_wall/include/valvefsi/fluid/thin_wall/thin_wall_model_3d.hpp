@@ -68,6 +68,11 @@ struct ThinWall3DSettings {
   // pressure and moves with that side's fluid velocity (no mirror), in the momentum and the
   // continuity equations (the 2D plate's --round-edge --round-edge-velocity).
   bool fluid_state_round_free_edge = false;
+  // The lattice's shadow test skips, per layer, the candidates a point's segment cannot meet:
+  // those wholly on the particle's side and those whose central projection from the particle
+  // onto the layer (a bounding rectangle, with a margin far above round-off) misses the point.
+  // Exact: the same first hit for every point. false tests every candidate (for the tests).
+  bool lattice_shadow_bounds = true;
 };
 
 // Consistent orientation of an open triangle mesh: flips triangles (per connected piece, from

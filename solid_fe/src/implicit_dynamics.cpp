@@ -18,6 +18,7 @@
 
 #include "valvefsi/solid/energy_growth_error.hpp"
 #include "valvefsi/solid/explicit_solver.hpp"
+#include "valvefsi/solid/generalized_alpha.hpp"
 #include "valvefsi/solid/material_error.hpp"
 #include "valvefsi/solid/newton_failure_error.hpp"
 
@@ -42,26 +43,13 @@ struct ExplicitSolver::ImplicitWork {
   // equivalents; moved into SolverState::block_work when a step is accepted.
   double pending_work = 0;
   Eigen::Matrix3Xd dx, a, v, r, net, net_n;
+  Eigen::Matrix3Xd imbalance_start, imbalance_end;  // M a + c M v - F at the step's ends (the ledger)
+  // The external force before this window's load replaced it, and whether the window's first
+  // step is still to come (the ledger's load-step part).
+  Eigen::Matrix3Xd external_before_window;
+  bool window_first_step = false;
   Eigen::VectorXd delta;
 };
-
-namespace {
-
-struct AlphaParameters {
-  double alpha_m, alpha_f, gamma, beta;
-};
-
-// Chung & Hulbert's optimal set for a given spectral radius at infinite frequency.
-AlphaParameters alpha_parameters(double rho_inf) {
-  AlphaParameters p{};
-  p.alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
-  p.alpha_f = rho_inf / (rho_inf + 1.0);
-  p.gamma = 0.5 - p.alpha_m + p.alpha_f;
-  p.beta = 0.25 * (1.0 - p.alpha_m + p.alpha_f) * (1.0 - p.alpha_m + p.alpha_f);
-  return p;
-}
-
-}  // namespace
 
 void ExplicitSolver::prepare_implicit() {
   if (planar_ || tie_) {
@@ -94,7 +82,7 @@ void ExplicitSolver::prepare_implicit() {
 bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_forces, double& residual,
                                    Eigen::Index& worst_node) {
   ImplicitWork& w = *implicit_;
-  const AlphaParameters p = alpha_parameters(options_.spectral_radius_infinity);
+  const GeneralizedAlphaParameters p = generalized_alpha_parameters(options_.spectral_radius_infinity);
   const Eigen::ArrayXd mass = elements_->nodal_mass().array();
   const double damping = mass_damping_at(state_.time);  // the step's, read at its start
   const SolverState start = state_;  // restored when Newton fails
@@ -234,7 +222,7 @@ bool ExplicitSolver::factorise_tangent(double h, double t_new, double mass_coeff
       for (const auto& b : w.blocks) add_block(b.row, b.col, stiffness_coefficient * b.k);
       if (options_.contact_damping_ratio > 0.0) {
         // The pairs' dashpots through the trial velocity: d(v)/d(x) = gamma / (beta h).
-        const AlphaParameters p = alpha_parameters(options_.spectral_radius_infinity);
+        const GeneralizedAlphaParameters p = generalized_alpha_parameters(options_.spectral_radius_infinity);
         w.blocks.clear();
         leaflet_contact_->add_damping_tangent(*elements_->contact_surface(), state_.position, penalty,
                                               options_.contact_damping_ratio,
@@ -267,8 +255,9 @@ bool ExplicitSolver::finish_implicit_step(const SolverState& start, double h) {
   const Eigen::Matrix3Xd& v_n = start.velocity;
   const Eigen::Index n = v_n.cols();
 
-  // Converged: the state at t_new, and the step's booking (trapezoidal works as the explicit
-  // ledger; what the net force's work did not put into kinetic energy is the scheme's dissipation).
+  // Converged: the state at t_new, and the step's booking: trapezoidal works as the explicit
+  // ledger, and the scheme's own dissipation from its energy identity (generalized_alpha.hpp), so
+  // that the balance is the work of the converged residual, sum dx . r (Newton tolerance).
   state_.velocity = w.v;
   state_.half_step_velocity = w.v;
   state_.acceleration = w.a;
@@ -276,7 +265,6 @@ bool ExplicitSolver::finish_implicit_step(const SolverState& start, double h) {
   state_.last_step = h;
   const Eigen::Matrix3Xd& dx = w.dx;
   EnergyBalance& e = state_.energy;
-  const double kinetic_before = e.kinetic;
   const double internal = 0.5 * (start.internal_force + state_.internal_force).cwiseProduct(dx).sum();
   const double external = 0.5 * (start.external_force + state_.external_force).cwiseProduct(dx).sum();
   const double contact = -0.5 * (start.contact_force + state_.contact_force).cwiseProduct(dx).sum();
@@ -289,7 +277,18 @@ bool ExplicitSolver::finish_implicit_step(const SolverState& start, double h) {
   e.contact_work += contact;
   e.damping_work += damped;
   update_kinetic_energy();
-  e.numerical_dissipation += external - internal - contact - damped - (e.kinetic - kinetic_before);
+  const auto imbalance = [&](const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& v, const Eigen::Matrix3Xd& net,
+                             Eigen::Matrix3Xd& out) { out = ((a + damping * v).array().rowwise() * mass.transpose()).matrix() - net; };
+  imbalance(start.acceleration, v_n, w.net_n, w.imbalance_start);
+  imbalance(w.a, w.v, w.net, w.imbalance_end);
+  const GeneralizedAlphaParameters p = generalized_alpha_parameters(options_.spectral_radius_infinity);
+  e.numerical_dissipation += generalized_alpha_dissipation(p, h, elements_->nodal_mass(), dx, start.acceleration,
+                                                           w.a, w.imbalance_start, w.imbalance_end);
+  if (w.window_first_step) {
+    e.load_step_dissipation +=
+        (0.5 - p.alpha_f) * dx.cwiseProduct(start.external_force - w.external_before_window).sum();
+    w.window_first_step = false;
+  }
   return true;
 }
 
@@ -331,13 +330,16 @@ void ExplicitSolver::drop_kept_tangent() {
 void ExplicitSolver::advance_window_implicit(double t_end, const Eigen::Matrix3Xd* nodal_forces) {
   if (!implicit_) prepare_implicit();
   const Eigen::Index n = state_.position.cols();
+  implicit_->external_before_window = state_.external_force;
   compute_external_force(state_.time, nodal_forces);  // this window's load at its start
   if (state_.acceleration.cols() != n) {
     // Start (or the switch from explicit): the acceleration the equation of motion gives now.
     compute_acceleration(elements_->nodal_mass().array().inverse());
     state_.acceleration = acceleration_ - mass_damping_at(state_.time) * state_.velocity;
     apply_constraints(state_.acceleration);
+    implicit_->external_before_window = state_.external_force;  // that acceleration holds the new load
   }
+  implicit_->window_first_step = implicit_->external_before_window.cols() == n;
   // Steps are max_time_step / 2^k, so that they divide output windows of that size and a kept
   // tangent (built for one step size) serves many steps.
   double h = options_.max_time_step;

@@ -171,6 +171,8 @@ void SeriesWriter::sample(const ExplicitSolver& solver, double pressure_Pa) {
     columns_["energy/hourglass_work"].push_back(e.hourglass_work);
     columns_["energy/hourglass_energy"].push_back(e.hourglass_energy);
   }
+  columns_["energy/numerical_dissipation"].push_back(e.numerical_dissipation);
+  columns_["energy/load_step_dissipation"].push_back(e.load_step_dissipation);
   columns_["energy/balance"].push_back(e.balance());
   columns_["energy/relative_balance_error"].push_back(e.relative_balance_error());
   for (std::size_t m = 0; m < monitors_.size(); ++m) {

@@ -100,6 +100,7 @@ void write_solver_restart(const ExplicitSolver& solver, coupling::RestartWriter&
   // Implicit dynamics and the automatic switch (ninth session): with the acceleration an implicit
   // continuation is bit for bit (the kept tangent is rebuilt by both runs, drop_kept_tangent).
   file.put("solid/energy/numerical_dissipation", s.energy.numerical_dissipation);
+  file.put("solid/energy/load_step_dissipation", s.energy.load_step_dissipation);
   put_matrix(file, "solid/acceleration", s.acceleration);
   file.put("solid/implicit_step", s.implicit_step);
   file.put_integer("solid/newton_iterations", s.newton_iterations);
@@ -175,6 +176,10 @@ void read_solver_restart(const coupling::RestartReader& file, ExplicitSolver& so
   // acceleration and starts with its first step, an AUTOMATIC one starts explicit)
   if (file.has("solid/implicit_phase")) {
     s.energy.numerical_dissipation = file.scalar("solid/energy/numerical_dissipation");
+    // (files before the seventeenth session: no load-step part booked yet)
+    s.energy.load_step_dissipation = file.has("solid/energy/load_step_dissipation")
+                                         ? file.scalar("solid/energy/load_step_dissipation")
+                                         : 0.0;
     s.acceleration = get_nodes(file, "solid/acceleration", n, true);
     s.implicit_step = file.scalar("solid/implicit_step");
     s.newton_iterations = static_cast<int>(file.integer("solid/newton_iterations"));

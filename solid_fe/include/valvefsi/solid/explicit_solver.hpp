@@ -31,10 +31,16 @@ struct EnergyBalance {
   double contact_work = 0;      // stored/dissipated in contact penalties (J)
   double tie_work = 0;          // done against coaptation ties: stored now + lost at releases (J)
   double tie_energy = 0;        // stored in the tied springs now (J)
-  // Implicit dynamics only: work of the net force (trapezoidal, as booked above) that did not
-  // reach the kinetic energy, i.e. removed by the generalized-alpha scheme's high-frequency
-  // damping (J); 0 for rho_inf = 1 up to the Newton tolerance, and for the explicit integrator.
+  // Implicit dynamics only: energy the generalized-alpha scheme removes (J; negative: creates),
+  // computed from each step's quantities by the scheme's energy identity (generalized_alpha.hpp),
+  // so that the balance is the converged Newton residual's work; exactly 0 for rho_inf = 1 and
+  // for the explicit integrator.
   double numerical_dissipation = 0;
+  // Of numerical_dissipation, the part from the external load's steps at window starts:
+  // (1/2 - alpha_f) dx . (F_new - F_old) of each window's first step, whose starting
+  // acceleration still holds the old load. A lagged, stiffness-like load (the fluid's) makes it
+  // negative: the scheme creates energy with the stepping loads, not on its own.
+  double load_step_dissipation = 0;
   // Coupled runs: the work of the coupler's loads as the coupler books it, sum over windows of
   // F_w . v(window start) * window size (J; 2D: the coupler's J/m times the strip depth). The
   // solid's own external_work books F_w . (x_end - x_start); the two differ by the explicit

@@ -18,6 +18,7 @@
 #include "valvefsi/coupling/participant.hpp"
 #include "valvefsi/coupling/restart_file.hpp"
 #include "valvefsi/fluid/case_setup.hpp"
+#include "valvefsi/fluid/coupling_window.hpp"
 #ifdef VALVEFSI_FLUID_HAS_THIN_WALL
 #include "valvefsi/fluid/thin_wall/thin_wall_model.hpp"
 #include "valvefsi/fluid/thin_wall/thin_wall_model_3d.hpp"
@@ -202,6 +203,8 @@ int run_coupled(const cases::Case& c, const std::filesystem::path& case_file, co
     coupling::InterfaceLoads loads{Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(node_count))};
     coupling::Window window;
     std::uint64_t repeats = 0;
+    const bool fit_window = c.fluid().fit_coupling_window_to_steps();
+    CouplingWindowFitter window_fitter(c.coupling().window_size());
     const long first_step = solver.step_count();
     bool unwritten = true;  // the initial state
     while (true) {
@@ -251,6 +254,7 @@ int run_coupled(const cases::Case& c, const std::filesystem::path& case_file, co
       }
       if (model != nullptr) model->set_window_target(window.end(), end_positions, end_velocities);
       solver.reset_surface_force_average();
+      const long window_first_step = solver.step_count();
       try {
         solver.advance_to(window.end());
       } catch (const FluidStop&) {
@@ -264,7 +268,9 @@ int run_coupled(const cases::Case& c, const std::filesystem::path& case_file, co
           loads.forces(d, static_cast<Eigen::Index>(j)) = forces[j][d];
           last_total[d] += forces[j][d];
         }
-      if (world.root()) participant->complete_window(loads, 0.0);  // the fluid sub-cycles: any window suits it
+      // The fluid sub-cycles, so any window is stable; fitted, the next one holds whole steps.
+      const double proposal = fit_window ? window_fitter.propose(solver.time_step(), solver.step_count() - window_first_step) : 0.0;
+      if (world.root()) participant->complete_window(loads, proposal);
       unwritten = true;
     }
     run_output.write_due(solver, last_total);
@@ -277,6 +283,9 @@ int run_coupled(const cases::Case& c, const std::filesystem::path& case_file, co
                  solver.time(), solver.step_count(), repeats, wall, updates / std::max(wall, 1e-9), solver.lost_count(),
                  solver.density_out_of_range_count(), counters.corrections, counters.leaks, counters.rejected_shifts,
                  output.string());
+    if (fit_window)
+      spdlog::info("fluid_sph: windows fitted to whole steps (fluid.fit_coupling_window_to_steps): {:.3f} steps per window",
+                   window_fitter.mean_steps_per_window());
     if (world.root()) participant->finalize();
     return 0;
   } catch (const coupling::TransportError& e) {

@@ -30,7 +30,7 @@ struct Processes {
 };
 
 Processes start(const std::string& name, double end_time, const std::vector<std::string>& solid_extra,
-                const std::string& scheme = "scheme: SERIAL_EXPLICIT") {
+                const std::string& scheme = "scheme: SERIAL_EXPLICIT", const std::string& fluid_extra = "") {
   Processes r;
   r.dir = valvefsi::testing::fresh_directory(name);
   const auto case_file = r.dir / "case.textproto";
@@ -48,6 +48,7 @@ fluid {{
   fluid_blocks {{ box {{ lower: [0.05, 0] upper: [0.1, {}] }} }}
   walls {{ container {{ lower: [0, 0] upper: [0.1, 10] }} }}
   thin_walls {{ }}
+  {}
 }}
 coupling {{
   {}
@@ -59,7 +60,7 @@ coupling {{
   startup_timeout_s: 60
 }}
 )",
-                                                       end_time, r.dir.string(), kLeft, kRight, scheme, r.dir.string()));
+                                                       end_time, r.dir.string(), kLeft, kRight, fluid_extra, scheme, r.dir.string()));
   const std::vector<std::string> common = {"--case", case_file.string(), "--output", r.dir.string()};
   auto with = [&](std::vector<std::string> argv, const std::vector<std::string>& extra) {
     argv.insert(argv.end(), extra.begin(), extra.end());
@@ -151,6 +152,45 @@ TEST(FluidParticipant, ImplicitSchemeRepeatsWindowsFromTheCheckpoint) {
   std::printf("implicit vs explicit: %zu windows, %d repeated, mean |dF_x| %.3e of %.3e N/m\n", a.size() / 3, repeats,
               mean_difference, scale);
   EXPECT_LT(mean_difference, 0.01 * scale);
+}
+
+// fluid.fit_coupling_window_to_steps: the case's 1e-4 s window holds 1.8 stable steps, so the
+// fluid takes two steps per window; fitted, it proposes one whole (0.97-shrunk) step per window
+// and takes exactly one step per window: 20 % fewer steps.
+TEST(FluidParticipant, FittedWindowsHoldWholeFluidSteps) {
+  const double end = 0.02;
+  Processes plain = start("fluid_participant_plain_windows", end, {});
+  Processes fitted = start("fluid_participant_fitted_windows", end, {}, "scheme: SERIAL_EXPLICIT",
+                           "fit_coupling_window_to_steps: true");
+  static const std::regex done(R"(in ([0-9]+) steps)");
+  struct Counts {
+    long steps = 0, windows = 0;
+    double last_window = 0;
+  };
+  auto counts = [&](Processes& r) {
+    const auto fluid_code = r.fluid->wait_for_exit(std::chrono::seconds(240));
+    EXPECT_TRUE(fluid_code && *fluid_code == 0) << r.fluid->log_text();
+    EXPECT_TRUE(r.coupler->wait_for_exit(std::chrono::seconds(20)));
+    EXPECT_TRUE(r.solid->wait_for_exit(std::chrono::seconds(20)));
+    Counts n;
+    std::smatch match;
+    const std::string log = r.fluid->log_text();
+    if (std::regex_search(log, match, done)) n.steps = std::stol(match[1].str());
+    const auto index = valvefsi::testing::read_series(r.dir / "coupling_series.h5", "window_index");
+    const auto size = valvefsi::testing::read_series(r.dir / "coupling_series.h5", "window_size");
+    if (!index.empty()) n.windows = static_cast<long>(index.back()) + 1;
+    if (!size.empty()) n.last_window = size.back();
+    return n;
+  };
+  const Counts a = counts(plain), b = counts(fitted);
+  std::printf("plain: %ld steps in %ld windows; fitted: %ld steps in %ld windows (last %.4g s)\n", a.steps, a.windows,
+              b.steps, b.windows, b.last_window);
+  EXPECT_EQ(a.windows, 200);  // 0.02 s of 1e-4 s windows
+  EXPECT_EQ(a.steps, 2 * a.windows);
+  EXPECT_LT(b.last_window, 1e-4);
+  EXPECT_GT(b.windows, a.windows);
+  EXPECT_EQ(b.steps, b.windows + 1);  // the first window, before any proposal, is the case's: 2 steps
+  EXPECT_LT(b.steps, a.steps * 85 / 100);
 }
 
 TEST(FluidParticipant, DeadSolidStopsTheFluidWithAMessage) {

@@ -1,12 +1,13 @@
 // A collapsing time step stops the run with a diagnosis instead of creeping on: a water block
 // thrown at 20 times its sound speed has an acoustic step cfl h / (c0 + v) 21 times below the
-// one at rest.
+// one at rest. And the coupling window a fluid proposes to hold whole steps.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
+#include "valvefsi/fluid/coupling_window.hpp"
 #include "valvefsi/fluid/fluid_solver.hpp"
 #include "valvefsi/fluid/geometry.hpp"
 
@@ -56,6 +57,37 @@ TEST(TimeStepGuard, CollapseStopsTheRunAndSaysWhy) {
 TEST(TimeStepGuard, AStepAboveTheGuardRuns) {
   EXPECT_EQ(run_steps(1200.0, 0.03), "");  // 1/21 = 0.048 of the step at rest
   EXPECT_EQ(run_steps(0.0, 0.9), "");
+}
+
+// The 3D sector's diastole: a 10.53 us window and stable steps of 5.1 us cost 3 steps per
+// window (5.1, 5.1, 0.33); fitted, 2 steps of 0.97 x 5.1 us.
+TEST(CouplingWindowFit, ProposesTheLargestWholeNumberOfShrunkSteps) {
+  EXPECT_NEAR(fitted_coupling_window(5.1e-6, 10.53e-6), 2 * 0.97 * 5.1e-6, 1e-18);
+  EXPECT_NEAR(fitted_coupling_window(3.0e-6, 10.53e-6), 3 * 0.97 * 3.0e-6, 1e-18);  // 4 steps -> 3
+  EXPECT_NEAR(fitted_coupling_window(8.0e-6, 10.53e-6), 0.97 * 8.0e-6, 1e-18);      // 2 steps -> 1
+}
+
+TEST(CouplingWindowFit, KeepsTheCaseWindowWhenFittingSavesLittleOrNothing) {
+  // 2 steps of 5.265 us fill the window: fitting would save 0.04 % of the steps.
+  EXPECT_EQ(fitted_coupling_window(5.43e-6, 10.53e-6), 0.0);
+  EXPECT_EQ(fitted_coupling_window(20e-6, 10.53e-6), 0.0);  // one clipped step per window
+  EXPECT_EQ(fitted_coupling_window(0.0, 10.53e-6), 0.0);
+  EXPECT_EQ(fitted_coupling_window(5e-6, 0.0), 0.0);
+  // 4.9 us: 3 steps of 3.51 us vs 2 of 4.753 us, a 35 % saving; demanded above 40 %, none.
+  EXPECT_GT(fitted_coupling_window(4.9e-6, 10.53e-6), 0.0);
+  EXPECT_EQ(fitted_coupling_window(4.9e-6, 10.53e-6, CouplingWindowFit{0.97, 0.4}), 0.0);
+}
+
+// The fitter proposes from the smallest step of its last windows, so a step that dips in one
+// window (a faster leaflet node) sizes the next windows until it leaves the memory.
+TEST(CouplingWindowFit, FitterRemembersTheSmallestRecentStep) {
+  CouplingWindowFitter fitter(10.53e-6, 3);
+  EXPECT_NEAR(fitter.propose(5.1e-6, 3), 2 * 0.97 * 5.1e-6, 1e-18);
+  EXPECT_NEAR(fitter.propose(4.8e-6, 2), 2 * 0.97 * 4.8e-6, 1e-18);
+  EXPECT_NEAR(fitter.propose(5.1e-6, 2), 2 * 0.97 * 4.8e-6, 1e-18);
+  EXPECT_NEAR(fitter.propose(5.1e-6, 2), 2 * 0.97 * 4.8e-6, 1e-18);
+  EXPECT_NEAR(fitter.propose(5.1e-6, 2), 2 * 0.97 * 5.1e-6, 1e-18);  // 4.8 us left the memory
+  EXPECT_DOUBLE_EQ(fitter.mean_steps_per_window(), 11.0 / 5.0);
 }
 
 }  // namespace

@@ -284,8 +284,9 @@ int run_coupled(const cases::Case& c, const std::filesystem::path& case_file, co
                  solver.density_out_of_range_count(), counters.corrections, counters.leaks, counters.rejected_shifts,
                  output.string());
     if (fit_window)
-      spdlog::info("fluid_sph: windows fitted to whole steps (fluid.fit_coupling_window_to_steps): {:.3f} steps per window",
-                   window_fitter.mean_steps_per_window());
+      spdlog::info("fluid_sph: windows fitted to whole steps (fluid.fit_coupling_window_to_steps): {:.3f} steps per "
+                   "window, {} window(s) overran their plan, step margin now {:.3f}",
+                   window_fitter.mean_steps_per_window(), window_fitter.overruns(), window_fitter.margin());
     if (world.root()) participant->finalize();
     return 0;
   } catch (const coupling::TransportError& e) {

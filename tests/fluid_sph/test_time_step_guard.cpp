@@ -78,16 +78,19 @@ TEST(CouplingWindowFit, KeepsTheCaseWindowWhenFittingSavesLittleOrNothing) {
   EXPECT_EQ(fitted_coupling_window(4.9e-6, 10.53e-6, CouplingWindowFit{0.97, 0.4}), 0.0);
 }
 
-// The fitter proposes from the smallest step of its last windows, so a step that dips in one
-// window (a faster leaflet node) sizes the next windows until it leaves the memory.
-TEST(CouplingWindowFit, FitterRemembersTheSmallestRecentStep) {
-  CouplingWindowFitter fitter(10.53e-6, 3);
-  EXPECT_NEAR(fitter.propose(5.1e-6, 3), 2 * 0.97 * 5.1e-6, 1e-18);
-  EXPECT_NEAR(fitter.propose(4.8e-6, 2), 2 * 0.97 * 4.8e-6, 1e-18);
-  EXPECT_NEAR(fitter.propose(5.1e-6, 2), 2 * 0.97 * 4.8e-6, 1e-18);
-  EXPECT_NEAR(fitter.propose(5.1e-6, 2), 2 * 0.97 * 4.8e-6, 1e-18);
-  EXPECT_NEAR(fitter.propose(5.1e-6, 2), 2 * 0.97 * 5.1e-6, 1e-18);  // 4.8 us left the memory
-  EXPECT_DOUBLE_EQ(fitter.mean_steps_per_window(), 11.0 / 5.0);
+// The fitter learns its margin: a window that took more steps than planned (the step fell
+// within it) shrinks the margin by 0.02; a window that kept to its plan grows it by 0.002.
+TEST(CouplingWindowFit, FitterShrinksItsMarginWhenAWindowOverruns) {
+  CouplingWindowFitter fitter(10.53e-6);
+  EXPECT_NEAR(fitter.propose(5.1e-6, 3), 2 * 0.97 * 5.1e-6, 1e-18);  // no plan yet: margin kept
+  EXPECT_NEAR(fitter.propose(5.1e-6, 3), 2 * 0.95 * 5.1e-6, 1e-18);  // 3 steps for 2 planned
+  EXPECT_NEAR(fitter.propose(5.1e-6, 2), 2 * 0.952 * 5.1e-6, 1e-18);  // kept to the plan
+  EXPECT_EQ(fitter.overruns(), 1);
+  EXPECT_DOUBLE_EQ(fitter.mean_steps_per_window(), 8.0 / 3.0);
+  for (int i = 0; i < 20; ++i) fitter.propose(5.1e-6, 3);  // overruns throughout: the floor
+  EXPECT_DOUBLE_EQ(fitter.margin(), 0.8);
+  for (int i = 0; i < 200; ++i) fitter.propose(5.1e-6, 2);  // never: the ceiling
+  EXPECT_DOUBLE_EQ(fitter.margin(), 0.99);
 }
 
 }  // namespace

@@ -217,6 +217,8 @@ def fluid_block(particle_spacing: float, cycles: int, setup: TubeSetup | None = 
         f"  # a pressure reserve for the diastolic blood columns, engaged in ejection (tube_case.py)",
         f"  plate_pressure_floor_mmHg: {FSI_3D_PLATE_PRESSURE_RESERVE_MMHG:g}",
         "  plate_pressure_floor_once_reached: true",
+        "  # windows of whole fluid steps: the diastole's 3 steps per window become ~2.1 (docs/fsi-3d.md, session 18)",
+        "  fit_coupling_window_to_steps: true",
         f"  thin_walls {{ load_smoothing_radius_ratio: {FSI_3D_LOAD_SMOOTHING_RADIUS_RATIO:g} }}",
         f"  domain_lower: {_vec([-margin if sector else -R_tube - margin, -margin if sector else -R_tube - margin, tube_start - margin])}",
         f"  domain_upper: {_vec([R_tube + margin, R_tube + margin, tube_end + margin])}",

@@ -80,6 +80,16 @@ class CaseFiles(unittest.TestCase):
                 # the solid program refuses it when coupled: the fluid damps the valve
                 self.assertNotIn("diastolic", solid, spec.name)
 
+    def test_fsi_cases_fit_their_coupling_windows_to_whole_fluid_steps(self):
+        # a window of 2.06 fluid steps costs 3 (fluid.fit_coupling_window_to_steps, docs/fsi-3d.md)
+        for spec in all_specs():
+            text = case_text(spec)
+            if spec.kind == "FE":
+                self.assertNotIn("fit_coupling_window_to_steps", text, spec.name)
+            else:
+                fluid = text[text.index("fluid {"):text.index("\n}\n", text.index("fluid {")) + 1]
+                self.assertIn("  fit_coupling_window_to_steps: true\n", fluid, spec.name)
+
     def test_every_3d_case_has_the_stent_cylinder(self):
         for spec in all_specs():
             self.assertIn(f"contact_cylinders {{ origin: [0, 0, 0] axis: [0, 0, 1] radius: {stent_radius():.6g} }}", case_text(spec))

@@ -310,5 +310,118 @@ class Smoothed(unittest.TestCase):
         self.assertAlmostEqual(r.peak_velocity_m_per_s, 1.4, delta=0.002)
 
 
+CLOSURE = TE + TC       # the closing backflow's end (s in the cycle)
+RING_PERIOD = 0.03      # s: the blood column between the plates rings after the closing ...
+RING_DECAY = 0.15       # s: ... its flow amplitude falling by e in this time ...
+RING_FLOW = 60e-6       # m^3/s: ... from this (the 3D sector's: ~32 ms, ~180 ms, ~75 mL/s)
+
+
+def ringing_series(stop, flow_scale=1.0):
+    """Cycle 1 to `stop` (s): the synthetic flow (closing backflow, then a constant leak) plus the
+    ringing, a decaying sine from the closing's end (the flow stays continuous), and the 2 kHz
+    ripple of 5 % of the peak flow; every section carries it (flow_scale: a sector's share)."""
+    full = synthetic(cycles=1)
+    keep = full.time <= stop + 1e-12
+    t = full.time[keep]
+    s = t - CLOSURE
+    ring = np.where(s > 0, RING_FLOW * np.exp(-s / RING_DECAY) * np.sin(2 * np.pi * s / RING_PERIOD), 0.0)
+    q = (flow(t) + ring + 0.05 * QMAX * np.sin(2 * np.pi * 2000.0 * t + 0.3)) * flow_scale
+    return hd.ProbeSeries(time=t, upstream_pressure=full.upstream_pressure[keep],
+                          downstream_pressure=full.downstream_pressure[keep], flow_rates={"a": q, "b": q},
+                          max_velocity=None)
+
+
+class LeakRate(unittest.TestCase):
+    """The closed valve's leak rate under the column's ringing (hemodynamics.leak_rate)."""
+    LEAK = Q_LEAK * 1e6          # mL/s, backflow positive
+    TOLERANCE = 0.01             # mL/s: 0.5 % of the leak
+
+    def analyse(self, stop, flow_scale=1.0, symmetry_factor=1.0):
+        return hd.analyse_cycle(ringing_series(stop, flow_scale), cycle=1, smoothing_s=0.0, closure_time_s=CLOSURE,
+                                allow_partial=stop < T, symmetry_factor=symmetry_factor)
+
+    def test_rate_period_and_decay_at_any_stop(self):
+        # stops at the backflow volume's ringing peaks (after 3.5 and 5.5 periods) and troughs (4 and 7
+        # periods), where the integral to the end misses most, between them, and at the cycle's end
+        stops = [CLOSURE + k * RING_PERIOD for k in (3.5, 4.0, 5.5, 7.0)] + [0.43, 0.62, T]
+        for stop in stops:
+            r = self.analyse(stop)
+            self.assertIsNotNone(r.leak, msg=f"stop {stop}: {r.leak_refusal}")
+            self.assertAlmostEqual(r.leak.rate, self.LEAK, delta=self.TOLERANCE, msg=f"stop {stop}")
+            self.assertAlmostEqual(r.leak.period_s, RING_PERIOD, delta=0.01 * RING_PERIOD, msg=f"stop {stop}")
+            self.assertAlmostEqual(r.leak.decay_time_s, RING_DECAY, delta=0.1 * RING_DECAY, msg=f"stop {stop}")
+            self.assertLess(r.leak.uncertainty, self.TOLERANCE, msg=f"stop {stop}")
+            # the fit starts one period after the closure and ends with the series
+            self.assertAlmostEqual(r.leak.start_s, CLOSURE + RING_PERIOD, delta=0.01 * RING_PERIOD)
+            self.assertAlmostEqual(r.leak.end_s, stop, delta=DT)
+            for name in ("a", "b"):
+                self.assertAlmostEqual(r.leak.section_rates[name], self.LEAK, delta=self.TOLERANCE)
+
+    def test_the_integral_to_the_end_misses_by_far_more(self):
+        for periods in (3.5, 4.0, 5.5, 7.0):   # peaks and troughs of the ringing's volume
+            stop = CLOSURE + periods * RING_PERIOD
+            r = self.analyse(stop)
+            raw_rate = r.leakage_volume / (stop - CLOSURE)
+            fit_miss, raw_miss = abs(r.leak.rate - self.LEAK), abs(raw_rate - self.LEAK)
+            self.assertLess(fit_miss, self.TOLERANCE)
+            self.assertGreater(raw_miss, 0.5, msg=f"{periods} periods")       # 25 % of the leak or more
+            self.assertGreater(raw_miss, 20 * fit_miss, msg=f"{periods} periods")
+
+    def test_partial_cycle_regurgitant_volume_is_extrapolated(self):
+        stop = CLOSURE + 5.5 * RING_PERIOD
+        r = self.analyse(stop)
+        self.assertTrue(r.regurgitant_extrapolated)
+        self.assertAlmostEqual(r.leakage_from_rate, r.leak.rate * (T - CLOSURE), delta=1e-12)
+        self.assertAlmostEqual(r.leakage_from_rate, self.LEAK * (T - CLOSURE), delta=self.TOLERANCE * (T - CLOSURE))
+        self.assertAlmostEqual(r.leakage_from_rate_uncertainty, r.leak.uncertainty * (T - CLOSURE), delta=1e-12)
+        self.assertAlmostEqual(r.regurgitant_volume, r.closing_volume + r.leakage_from_rate, delta=1e-12)
+        # the integral to the series' end stays, and the table shows both, marked
+        self.assertAlmostEqual(r.leakage_volume, -hd.integral(ringing_series(stop).time,
+                                                              ringing_series(stop).mean_flow_rate,
+                                                              CLOSURE, stop) * 1e6, delta=1e-12)
+        table = hd.hemodynamics_table({"part": r})
+        self.assertIn(f"| {r.regurgitant_volume:.2f} (extrap.) |", table)
+        self.assertIn(f"| — leakage to the series' end, −∫Q (mL) | {r.leakage_volume:.2f} |", table)
+        self.assertIn(f"| {r.leakage_from_rate:.2f} ± {r.leakage_from_rate_uncertainty:.2f} (extrap.) |", table)
+        self.assertIn("; 30.0, 150 |", table)   # period and e-folding time (ms)
+
+    def test_complete_cycle_keeps_the_integral(self):
+        r = self.analyse(T)
+        self.assertFalse(r.regurgitant_extrapolated)
+        self.assertAlmostEqual(r.regurgitant_volume, r.closing_volume + r.leakage_volume, delta=1e-12)
+        self.assertNotIn("(extrap.)", hd.hemodynamics_table({"whole": r}))
+
+    def test_too_short_a_span_is_refused(self):
+        stop = CLOSURE + 2.5 * RING_PERIOD   # three periods needed: one skipped, two fitted
+        r = self.analyse(stop)
+        self.assertIsNone(r.leak)
+        self.assertIsNone(r.leakage_from_rate)
+        self.assertRegex(r.leak_refusal, r"holds 75 ms after the closure, less than three ringing periods \(30\.\d ms\)")
+        # the partial cycle's regurgitant volume falls back to the integral to the end, unmarked
+        self.assertFalse(r.regurgitant_extrapolated)
+        self.assertAlmostEqual(r.regurgitant_volume, r.closing_volume + r.leakage_volume, delta=1e-12)
+        self.assertIn("No leak rate: short: the series holds 75 ms", hd.hemodynamics_table({"short": r}))
+        # within one period the ringing is not found, and a line does not fit either
+        r = self.analyse(CLOSURE + RING_PERIOD)
+        self.assertIsNone(r.leak)
+        self.assertRegex(r.leak_refusal, "no ringing period within half of the 30 ms after the closure, .*too short a span")
+
+    def test_a_sector_times_six_is_the_valve(self):
+        stop = CLOSURE + 5.5 * RING_PERIOD
+        valve = self.analyse(stop)
+        sector = self.analyse(stop, flow_scale=1 / 6, symmetry_factor=6)
+        for name in ("rate", "uncertainty", "period_s", "decay_time_s", "ringing_volume"):
+            a, b = getattr(valve.leak, name), getattr(sector.leak, name)
+            self.assertAlmostEqual(a, b, delta=1e-6 * max(1.0, abs(a)), msg=name)
+        self.assertAlmostEqual(sector.leak.rate, self.LEAK, delta=self.TOLERANCE)
+        self.assertAlmostEqual(sector.leakage_from_rate, valve.leakage_from_rate, delta=1e-6)
+
+    def test_without_ringing_the_rate_is_the_slope_from_the_closure(self):
+        r = hd.analyse_cycle(synthetic(), cycle=2, smoothing_s=0.0, closure_time_s=CLOSURE)
+        self.assertIsNone(r.leak.period_s)
+        self.assertAlmostEqual(r.leak.rate, self.LEAK, delta=1e-6)
+        self.assertAlmostEqual(r.leak.start_s, CLOSURE, delta=DT)
+        self.assertIn("; no ringing |", hd.hemodynamics_table({"steady": r}))
+
 if __name__ == "__main__":
     unittest.main()

@@ -36,6 +36,13 @@ Definitions (reference Sec. 2.4 and 3.3, after ISO 5840; written in docs/hemodyn
   oscillation (the blood column ringing between the plates), to the backflow volume after the
   closing (leak_rate below, where the choice is argued); a partial cycle's regurgitant volume
   is closing + the leak rate x (cycle end - closure), labelled extrapolated;
+- leak rate through the valve (3D, where the run has fluid particle snapshots, the leaflets'
+  snapshots and its particle spacing): the slope of a line fitted to the volume of the fluid
+  particles on the ventricle's side of the closed valve (their count x dp^3; valve_side,
+  valve_leak), from where the fit above starts to the series' end. Where it is measured it is
+  the leak rate the leakage and a partial cycle's regurgitant volume use: in diastole the flow
+  sections' velocity sum misses the particle shifting's displacements, which carry 1-5 mL/s
+  through the sections next to the valve (docs/fsi-3d.md, session 18, helper 62);
 - peak pull-out force: the maximum axial leaflet force over [t1, t2] (downstream positive);
 - peak diastolic force: the minimum axial leaflet force after t2; water-hammer ratio = its
   magnitude over the hydrostatic force Pmax * A (Pmax the waveform's largest reverse
@@ -48,6 +55,7 @@ from __future__ import annotations
 import argparse
 import functools
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -91,6 +99,9 @@ class ProbeSeries:
     downstream_centre: np.ndarray | None = None
     force_time: np.ndarray | None = None    # coupling window ends (s)
     axial_force: np.ndarray | None = None   # N (N/m in 2D), downstream positive
+    particle_run: Path | None = None        # 3D: the run whose particle and leaflet snapshots give the
+                                            # leak through the valve (valve_leak), or None
+    particle_spacing: float | None = None   # m: its particles' spacing (volume dp^3 each), or None
 
     @property
     def mean_flow_rate(self) -> np.ndarray:
@@ -121,6 +132,20 @@ class LeakRate:
     decay_time_s: float | None      # e-folding time of its amplitude (inf: steady; < 0: it grows)
     ringing_volume: float           # its amplitude in the backflow volume at start_s (mL; 2D cm^2)
     section_rates: dict             # section -> its leak rate with the same ringing's period and decay
+
+
+@dataclass
+class ValveLeak:
+    """The leak through the closed valve by mass (valve_leak): whole valve, backflow positive, in
+    the volume units of CycleHemodynamics per second (mL/s)."""
+    rate: float
+    uncertainty: float              # half the difference between the two halves' rates
+    first_half_rate: float
+    second_half_rate: float
+    start_s: float                  # the fitted span, s within the cycle
+    end_s: float
+    snapshots: int                  # particle snapshots in the span
+    volume_change: float            # the ventricle side's particle volume, last minus first snapshot (mL)
 
 
 @dataclass
@@ -162,12 +187,19 @@ class CycleHemodynamics:
     leakage_from_rate_uncertainty: float | None = None   # leak.uncertainty x (cycle end - closure)
     regurgitant_extrapolated: bool = False         # regurgitant_volume = closing + leakage_from_rate
                                                    # (a partial cycle), not closing + leakage_volume
+    valve_leak: ValveLeak | None = None            # the leak through the valve by particle count (3D)
+    valve_leak_refusal: str = ""                   # why there is none (empty: not attempted or measured)
+    leakage_rate_source: str = ""                  # "particles" (valve_leak) or "flow sections" (leak)
 
 
 def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "downstream_tap",
-             velocity_plane: str | None = None, sections: list[str] | None = None) -> ProbeSeries:
+             velocity_plane: str | None = None, sections: list[str] | None = None,
+             particles: bool = True) -> ProbeSeries:
     """Reads RUN_DIR/fluid_probes.h5 and, if present, RUN_DIR/coupling_series.h5. `sections`
-    chooses the flow sections averaged (default: all)."""
+    chooses the flow sections averaged (default: all). particles: a 3D run with the leaflets'
+    snapshots (solid_fields.h5) and fluid particle snapshots (its own or its segments') is marked
+    for the leak through the valve by particle count (valve_leak; read when a cycle is analysed),
+    with the particle spacing from the fluid's log (None if no log says it)."""
     import h5py
     run_dir = Path(run_dir)
     path = run_dir / "fluid_probes.h5"
@@ -216,7 +248,172 @@ def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "d
                 axis = 2 if series.dimension == 3 else 0
                 series.force_time = f["time"][()].reshape(-1)
                 series.axial_force = f["force_fluid"][()][:, axis]
+    if particles and series.dimension == 3 and (run_dir / "solid_fields.h5").exists() and particle_snapshots(run_dir):
+        series.particle_run = run_dir
+        series.particle_spacing = particle_spacing_of(run_dir)
     return series
+
+
+# ---------------------------------------------------------------------------------------------
+# The leak through the valve by particle count
+
+
+VALVE_SIDE_MARGIN_M = 3e-3        # within this of the leaflets' extent the side is the leaflets'
+VALVE_SIDE_RADIAL_MARGIN_M = 1e-4  # beyond the attachment radius by this: the sinus or under the gasket
+VALVE_SNAPSHOT_TOLERANCE_S = 5e-4  # a fluid snapshot takes the leaflet snapshot this close in time
+VALVE_LEAK_FALLBACK_DELAY_S = 0.032  # without the flow sections' fit: the span starts this long after the closure
+VALVE_LEAK_MIN_SNAPSHOTS = 6
+PARTICLE_FLUID, PARTICLE_LOST = 0, 2   # fluid_particles.h5 /kind (fluid_sph Kind)
+SPACING_IN_LOG = re.compile(r"\bdp = ([0-9.eE+-]+) m\b")
+
+
+def _segments(run_dir: Path) -> list[Path]:
+    from .join_segments import segments_of
+    return segments_of(run_dir)
+
+
+def particle_snapshots(run_dir: Path) -> list[tuple[float, Path, str]]:
+    """(time, file, group) of the fluid particle snapshots of a run, in time order: its own
+    fluid_particles.h5, or, for a run joined from restart segments (join_segments, which does not
+    copy them), its segments': segment k contributes its snapshots before the first of the next
+    segment that has any (the later segment wins, as in the join)."""
+    import h5py
+    run_dir = Path(run_dir)
+    files = [d / "fluid_particles.h5" for d in [run_dir] + _segments(run_dir) if (d / "fluid_particles.h5").exists()]
+    per_file = []
+    for path in files:
+        with h5py.File(path, "r") as f:
+            found = sorted((float(f[n].attrs["time"]), path, n) for n in f if n.startswith("snapshot_"))
+        if found:
+            per_file.append(found)
+    out = []
+    for k, found in enumerate(per_file):
+        limit = per_file[k + 1][0][0] if k + 1 < len(per_file) else math.inf
+        out += [entry for entry in found if entry[0] < limit]
+    return out
+
+
+def particle_spacing_of(run_dir: Path) -> float | None:
+    """The fluid's particle spacing (m) as its log (fluid.log: "dp = ... m") states it, from the run
+    folder or its segments; None if none does."""
+    for folder in [Path(run_dir)] + _segments(run_dir):
+        log = folder / "fluid.log"
+        if log.is_file():
+            with open(log, errors="replace") as f:
+                for line in f:
+                    found = SPACING_IN_LOG.search(line)
+                    if found:
+                        return float(found.group(1))
+    return None
+
+
+def _surface_samples(nodes: np.ndarray, triangles: np.ndarray, level: int = 5) -> tuple[np.ndarray, np.ndarray]:
+    """Points on every triangle (a barycentric grid, level + 1 per edge) and their triangle's unit
+    normal, oriented so that the mesh's area-weighted normal points along +z (downstream)."""
+    a, b, c = nodes[triangles[:, 0]], nodes[triangles[:, 1]], nodes[triangles[:, 2]]
+    n = np.cross(b - a, c - a)
+    if np.sum(n[:, 2]) < 0:
+        n = -n
+    n = n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+    points, normals = [], []
+    for i in range(level + 1):
+        for j in range(level + 1 - i):
+            points.append(a + (i / level) * (b - a) + (j / level) * (c - a))
+            normals.append(n)
+    return np.concatenate(points), np.concatenate(normals)
+
+
+def valve_side(points: np.ndarray, nodes: np.ndarray, triangles: np.ndarray, base_z: float, top_z: float,
+               radius: float, margin: float = VALVE_SIDE_MARGIN_M,
+               radial_margin: float = VALVE_SIDE_RADIAL_MARGIN_M) -> np.ndarray:
+    """+1 (aorta's side) or -1 (ventricle's side) of the closed valve for each point [n, 3], the
+    flow along +z: within radius + radial_margin of the axis and between base_z - margin and
+    top_z + margin (the leaflets' extent: annulus plane to commissure tops), the side of the
+    leaflets' mid-surface (nodes, triangles, consistently oriented) nearest the point; outside
+    that radius, above base_z is the sinus (aorta), below it the gasket's underside (ventricle);
+    below and above the leaflets' extent, the ventricle and the aorta. A point's side is the
+    leaflet's only while the valve is closed."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    z, r = points[:, 2], np.hypot(points[:, 0], points[:, 1])
+    side = np.where(z > base_z, 1, -1)
+    near = (r <= radius + radial_margin) & (z > base_z - margin) & (z < top_z + margin)
+    if np.any(near):
+        samples, normals = _surface_samples(np.asarray(nodes, dtype=float), np.asarray(triangles))
+        q = points[near]
+        nearest = np.empty(len(q), dtype=int)
+        s2 = np.sum(samples ** 2, axis=1)
+        for i0 in range(0, len(q), 2000):
+            block = q[i0:i0 + 2000]
+            nearest[i0:i0 + 2000] = np.argmin(s2[None, :] - 2.0 * block @ samples.T, axis=1)
+        signed = np.einsum("ij,ij->i", q - samples[nearest], normals[nearest])
+        side[near] = np.where(signed > 0, 1, -1)
+    return side
+
+
+@functools.lru_cache(maxsize=8)
+def _ventricle_side_counts(run_dir: Path, start: float, end: float) -> tuple[np.ndarray, np.ndarray]:
+    """(times, fluid particles on the ventricle's side) at the particle snapshots in [start, end]
+    that have a leaflet snapshot within VALVE_SNAPSHOT_TOLERANCE_S. Particles the fluid took out
+    (kind lost: their density left the allowed band, most of them squeezed in the coaptation
+    zone) count where they stay, so that a loss is not read as a leak."""
+    import h5py
+    with h5py.File(run_dir / "solid_fields.h5", "r") as f:
+        reference = f["mesh/nodes"][()]
+        triangles = f["mesh/triangles"][()]
+        names = sorted(f["snapshots"])
+        solid_times = np.array([float(f["snapshots"][n].attrs["time"]) for n in names])
+    base_z, top_z = float(reference[:, 2].min()), float(reference[:, 2].max())
+    radius = float(np.max(np.hypot(reference[:, 0], reference[:, 1])))
+    times, counts = [], []
+    for t, path, group in particle_snapshots(run_dir):
+        if not (start - 1e-9 <= t <= end + 1e-9) or len(solid_times) == 0:
+            continue
+        k = int(np.argmin(np.abs(solid_times - t)))
+        if abs(solid_times[k] - t) > VALVE_SNAPSHOT_TOLERANCE_S:
+            continue
+        with h5py.File(run_dir / "solid_fields.h5", "r") as f:
+            nodes = f["snapshots"][names[k]]["position"][()]
+        with h5py.File(path, "r") as f:
+            kind = f[group]["kind"][()].reshape(-1)
+            x = f[group]["position"][()][(kind == PARTICLE_FLUID) | (kind == PARTICLE_LOST)]
+        times.append(t)
+        counts.append(int(np.count_nonzero(valve_side(x, nodes, triangles, base_z, top_z, radius) < 0)))
+    return np.array(times), np.array(counts, dtype=float)
+
+
+def valve_leak(series: ProbeSeries, closure: float, end: float, start: float, to_volume: float,
+               symmetry_factor: float = 1.0, cycle_start: float = 0.0,
+               particle_spacing: float | None = None) -> tuple[ValveLeak | None, str]:
+    """The leak through the closed valve by mass, from the run's particle snapshots: the volume of
+    the fluid particles on the ventricle's side (count x dp^3 x symmetry_factor, in to_volume
+    units), fitted by a line over [start, end] (s; start after the closure); uncertainty half the
+    difference between the rates of the span's two halves. Returns (ValveLeak, "") or (None, why).
+
+    Why: the flow sections' rates sum the particles' velocities over a slab, and in diastole the
+    particle shifting (which moves particles without velocity, towards the closed leaflets from
+    both sides) carries 1-5 mL/s through the sections next to the valve that the velocities do
+    not (docs/fsi-3d.md, session 18, helper 62). A particle's mass crosses the valve only through
+    it; the count on the ventricle's side changes by nothing else (lost particles aside), does not
+    ring with the blood columns and is blind to the leaflets' bulging."""
+    if series.particle_run is None:
+        return None, ""
+    spacing = particle_spacing or series.particle_spacing
+    if not spacing:
+        return None, "the particle spacing is unknown (no fluid.log states 'dp = ... m'; pass particle_spacing)"
+    if start < closure:
+        start = closure
+    times, counts = _ventricle_side_counts(Path(series.particle_run), float(start), float(end))
+    if len(times) < VALVE_LEAK_MIN_SNAPSHOTS:
+        return None, (f"{len(times)} particle snapshots with the leaflets' between {(start - cycle_start) * 1e3:.0f} and "
+                      f"{(end - cycle_start) * 1e3:.0f} ms, fewer than {VALVE_LEAK_MIN_SNAPSHOTS}")
+    volume = counts * spacing ** 3 * symmetry_factor * to_volume
+    tau = times - times[0]
+    rate = float(np.polyfit(tau, volume, 1)[0])
+    half = len(tau) // 2
+    halves = [float(np.polyfit(tau[part], volume[part], 1)[0]) for part in (slice(0, half + 1), slice(half, None))]
+    return ValveLeak(rate=rate, uncertainty=0.5 * abs(halves[0] - halves[1]), first_half_rate=halves[0],
+                     second_half_rate=halves[1], start_s=float(times[0] - cycle_start), end_s=float(times[-1] - cycle_start),
+                     snapshots=len(times), volume_change=float(volume[-1] - volume[0])), ""
 
 
 def moving_average(t: np.ndarray, y: np.ndarray, width_s: float) -> np.ndarray:
@@ -448,7 +645,8 @@ def annulus_area(dimension: int, radius: float = ANNULUS_RADIUS_M) -> float:
 def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.PERIOD_S,
                   smoothing_s: float = 0.002, closure_time_s: float | None = None,
                   hydrostatic_Pa: float | None = None, annulus_radius: float = ANNULUS_RADIUS_M,
-                  symmetry_factor: float = 1.0, allow_partial: bool = False) -> CycleHemodynamics:
+                  symmetry_factor: float = 1.0, allow_partial: bool = False,
+                  particle_spacing: float | None = None) -> CycleHemodynamics:
     """Metrics of cycle `cycle` (1-based: [(cycle-1) T, cycle T)). closure_time_s, if given, is
     the valve's closure within the cycle (e.g. from the kinematics) and splits closing from
     leakage volume. symmetry_factor multiplies the flows and forces of a symmetric part (6 for
@@ -456,7 +654,10 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
     cycle does, once the forward flow has ended in it (a run that covers only the parts of the
     cycle the metrics need): the result's series_end_s says where the diastolic quantities stop,
     and its regurgitant volume is closing + the leak rate x (cycle end - closure) when the leak
-    rate is measured (regurgitant_extrapolated; leakage_volume stays the integral to the end)."""
+    rate is measured (regurgitant_extrapolated; leakage_volume stays the integral to the end).
+    Where the series has particle snapshots (read_run) the leak through the valve by particle
+    count (valve_leak; particle_spacing overrides the log's) is the leak rate the leakage from
+    the rate uses; else the flow sections' fit (leak_rate)."""
     start, end = (cycle - 1) * period, cycle * period
     t_all = series.time
     sel = (t_all >= start - 1e-12) & (t_all <= end + 1e-12)
@@ -489,8 +690,14 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
     leakage = -integral(t, q, t_close, t[-1]) * to_volume
     leak, leak_refusal = leak_rate(t, q, t_close, to_volume, cycle_start=start,
                                    sections={name: rate[sel] * symmetry_factor for name, rate in series.flow_rates.items()})
-    leakage_from_rate = None if leak is None else leak.rate * (end - t_close)
-    leakage_from_rate_uncertainty = None if leak is None else leak.uncertainty * (end - t_close)
+    valve_start = start + leak.start_s if leak is not None else t_close + VALVE_LEAK_FALLBACK_DELAY_S
+    valve, valve_refusal = valve_leak(series, t_close, float(t[-1]), valve_start, to_volume,
+                                      symmetry_factor=symmetry_factor, cycle_start=start,
+                                      particle_spacing=particle_spacing)
+    chosen = valve if valve is not None else leak
+    source = "" if chosen is None else ("particles" if valve is not None else "flow sections")
+    leakage_from_rate = None if chosen is None else chosen.rate * (end - t_close)
+    leakage_from_rate_uncertainty = None if chosen is None else chosen.uncertainty * (end - t_close)
     extrapolated = partial and leakage_from_rate is not None
     peak_q = float(np.max(q)) * to_volume
     sections = {name: integral(t, rate[sel] * symmetry_factor, t1, t2) * to_volume for name, rate in series.flow_rates.items()}
@@ -534,7 +741,8 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
         series_end_s=float(t[-1] - start) if partial else None, symmetry_factor=symmetry_factor,
         leak=leak, leak_refusal=leak_refusal, leakage_from_rate=leakage_from_rate,
         leakage_from_rate_uncertainty=leakage_from_rate_uncertainty,
-        regurgitant_extrapolated=extrapolated)
+        regurgitant_extrapolated=extrapolated, valve_leak=valve, valve_leak_refusal=valve_refusal,
+        leakage_rate_source=source)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -582,7 +790,15 @@ def hemodynamics_table(results: dict) -> str:
         if r.leakage_from_rate is None:
             return "–"
         cell = f"{r.leakage_from_rate:.2f} ± {r.leakage_from_rate_uncertainty:.2f}"
-        return cell + (" (extrap.)" if r.series_end_s is not None else "")
+        cell += " (extrap.)" if r.series_end_s is not None else ""
+        return cell + (" (particles)" if r.leakage_rate_source == "particles" else "")
+
+    def valve_leak_cell(r):
+        k = r.valve_leak
+        if k is None:
+            return "–"
+        return (f"{k.rate:.2f} ± {k.uncertainty:.2f} (halves {k.first_half_rate:.2f}, {k.second_half_rate:.2f}; "
+                f"{k.start_s * 1e3:.0f}–{k.end_s * 1e3:.0f} ms, {k.snapshots} snapshots)")
 
     def section_rates_cell(r):
         rates = list(r.leak.section_rates.values()) if r.leak is not None else []
@@ -612,7 +828,10 @@ def hemodynamics_table(results: dict) -> str:
         (f"— closing ({u['volume']})", lambda r: _f(r.closing_volume, 2), none),
         (f"— leakage to the series' end, −∫Q ({u['volume']})", lambda r: _f(r.leakage_volume, 2), none),
         (f"— leak rate, backflow, fitted ± half its halves' difference ({u['volume']}/s)", leak_rate_cell, none),
-        (f"— leakage from the leak rate, closure to cycle end ({u['volume']})", leakage_from_rate_cell, none),
+        (f"— leak rate through the valve, particles on the ventricle's side, ± half its halves' difference "
+         f"({u['volume']}/s)", valve_leak_cell, none),
+        (f"— leakage from the leak rate (through the valve where measured: particles), closure to cycle end "
+         f"({u['volume']})", leakage_from_rate_cell, none),
         (f"— leak rate by flow section, lowest to highest ({u['volume']}/s)", section_rates_cell, none),
         ("— leak-rate fit: span (ms in the cycle); ringing period, e-folding time (ms)", leak_fit_cell, none),
         (f"peak flow rate ({u['flow_min']})", lambda r: _f(r.peak_flow_L_per_min, 2), ref("peak_flow_L_per_min", 1)),
@@ -634,6 +853,9 @@ def hemodynamics_table(results: dict) -> str:
     refusals = [f"{m}: {r.leak_refusal}" for m, r in results.items() if r.leak_refusal]
     if refusals:
         rows += ["", "No leak rate: " + "; ".join(refusals) + "."]
+    refusals = [f"{m}: {r.valve_leak_refusal}" for m, r in results.items() if r.valve_leak_refusal]
+    if refusals:
+        rows += ["", "No leak rate through the valve by particle count: " + "; ".join(refusals) + "."]
     return "\n".join(rows) + "\n"
 
 
@@ -697,10 +919,14 @@ def main(argv=None) -> None:
     parser.add_argument("--png", type=Path, help="write the Fig. 11-like plot here")
     parser.add_argument("--partial", action="store_true",
                         help="accept a cycle the series does not finish, once its forward flow has ended")
+    parser.add_argument("--no-particles", action="store_true",
+                        help="do not read the particle snapshots for the leak through the valve")
+    parser.add_argument("--particle-spacing", type=float,
+                        help="the fluid's particle spacing (m) where no fluid.log states it")
     args = parser.parse_args(argv)
-    series = read_run(args.run_dir, sections=args.sections)
+    series = read_run(args.run_dir, sections=args.sections, particles=not args.no_particles)
     result = analyse_cycle(series, args.cycle, closure_time_s=args.closure_time, symmetry_factor=args.symmetry_factor,
-                           allow_partial=args.partial)
+                           allow_partial=args.partial, particle_spacing=args.particle_spacing)
     table = hemodynamics_table({args.model: result})
     print(table)
     print("section stroke volumes:", {k: round(v, 3) for k, v in result.section_stroke_volumes.items()})

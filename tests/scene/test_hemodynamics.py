@@ -2,6 +2,7 @@
 ejection (known rms and volume), a known pressure drop, a closing backflow plus a constant
 leak (known regurgitant volume), a known leaflet force, two cycles, 2D units, and the HDF5
 layouts of fluid_sph and the coupler."""
+import json
 import math
 import tempfile
 import unittest
@@ -422,6 +423,245 @@ class LeakRate(unittest.TestCase):
         self.assertAlmostEqual(r.leak.rate, self.LEAK, delta=1e-6)
         self.assertAlmostEqual(r.leak.start_s, CLOSURE, delta=DT)
         self.assertIn("; no ringing |", hd.hemodynamics_table({"steady": r}))
+
+
+# The leak through the valve by particle count (hemodynamics.valve_leak): a 60-degree sector's
+# leaflet (a flat disc sector at z = 5 mm, attached at R, bulging towards the ventricle and
+# ringing), particles on both sides of it and far from it, and a known number moving from the
+# aorta's side to the ventricle's per second; the flow sections read a different "leak".
+VALVE_R = 11.5e-3
+VALVE_Z = 5e-3
+SPACING = 3e-4                 # m: particle volume 2.7e-11 m^3, ~9 particles per 2 ms at the leak below
+TRUE_LEAK = 0.75               # mL/s, whole valve (x 6)
+SNAPSHOT_DT = 0.002
+
+
+def leaflet_mesh(rings=6, spokes=6):
+    """Nodes (reference, flat at VALVE_Z) and triangles (normals +z) of a 60-degree disc sector."""
+    nodes = [[0.0, 0.0, VALVE_Z]]
+    for i in range(1, rings + 1):
+        for j in range(spokes + 1):
+            a = math.radians(60.0) * j / spokes
+            nodes.append([VALVE_R * i / rings * math.cos(a), VALVE_R * i / rings * math.sin(a), VALVE_Z])
+    index = lambda i, j: 0 if i == 0 else 1 + (i - 1) * (spokes + 1) + j
+    triangles = []
+    for i in range(rings):
+        for j in range(spokes):
+            if i == 0:
+                triangles.append([index(0, 0), index(1, j), index(1, j + 1)])
+            else:
+                triangles.append([index(i, j), index(i + 1, j), index(i + 1, j + 1)])
+                triangles.append([index(i, j), index(i + 1, j + 1), index(i, j + 1)])
+    return np.array(nodes), np.array(triangles)
+
+
+def bulge(t):
+    """The leaflet's centre deflection towards the ventricle (m): 1 mm, ringing by 0.3 mm."""
+    return 1e-3 + 3e-4 * np.sin(2 * np.pi * max(t - CLOSURE, 0.0) / RING_PERIOD)
+
+
+def leaflet_at(nodes, t):
+    r = np.hypot(nodes[:, 0], nodes[:, 1])
+    out = nodes.copy()
+    out[:, 2] -= bulge(t) * (1 - (r / VALVE_R) ** 2)
+    return out
+
+
+def wedge_points(rng, n, z_low, z_high, r_max=0.0184):
+    r = r_max * np.sqrt(rng.uniform(0, 1, n))
+    a = rng.uniform(0.02, math.radians(58.0), n)
+    return np.column_stack([r * np.cos(a), r * np.sin(a), rng.uniform(z_low, z_high, n)])
+
+
+class ValveScene:
+    """Particle snapshots of the scene at `times`: n_moved(t) particles have crossed to the ventricle."""
+
+    def __init__(self, times, seed=1):
+        rng = np.random.default_rng(seed)
+        self.times = np.asarray(times)
+        self.nodes, self.triangles = leaflet_mesh()
+        self.ventricle = wedge_points(rng, 300, -0.04, -0.01)
+        self.aorta = wedge_points(rng, 3000, 0.02, 0.06)
+        sinus = wedge_points(rng, 50, 0.006, 0.012)   # beyond the attachment radius, above the base
+        r = np.hypot(sinus[:, 0], sinus[:, 1])
+        sinus[:, :2] *= ((0.012 + 0.006 * r / 0.0184) / r)[:, None]
+        self.sinus = sinus
+        near = wedge_points(rng, 200, 0, 0, r_max=0.9 * VALVE_R)
+        self.near_r = near[:, :2]
+        self.per_second = TRUE_LEAK * 1e-6 / (6 * SPACING ** 3)     # particles per second (sector)
+
+    def moved(self, t):
+        return int(round(self.per_second * max(t - CLOSURE, 0.0)))
+
+    def snapshot(self, t):
+        """(positions, kind): near-leaflet particles 0.4 mm either side of the bulging surface,
+        far ones, the sinus's; the movers taken from the aorta's far set into the ventricle's."""
+        r = np.hypot(self.near_r[:, 0], self.near_r[:, 1])
+        zs = VALVE_Z - bulge(t) * (1 - (r / VALVE_R) ** 2)
+        below = np.column_stack([self.near_r, zs - 4e-4])
+        above = np.column_stack([self.near_r, zs + 4e-4])
+        k = self.moved(t)
+        aorta, moved = self.aorta[k:], self.aorta[:k].copy()
+        moved[:, 2] = -0.01 - 0.5 * (moved[:, 2] - 0.02)    # from 20-60 mm above to 10-30 mm below
+        x = np.concatenate([self.ventricle, moved, below, above, self.sinus, aorta])
+        kind = np.zeros(len(x), dtype=np.int32)
+        if t > CLOSURE + 0.08:        # mid-span, 40 particles taken out on the ventricle's side stay counted
+            kind[:40] = 2
+        return x, kind
+
+    def ventricle_count(self, t):
+        return len(self.ventricle) + self.moved(t) + len(self.near_r)
+
+
+def write_valve_run(folder: Path, stop: float, scene: ValveScene, particle_times=None, log=True,
+                    section_error=(-5e-6, 2e-6)):
+    """A 3D sector run: probes (ringing_series's flows / 6, each section off the true leak by
+    section_error, m^3/s whole valve), leaflet snapshots every 2 ms, particle snapshots at
+    particle_times (default: the scene's), fluid.log stating the spacing."""
+    folder.mkdir(parents=True, exist_ok=True)
+    series = ringing_series(stop)
+    t = series.time
+    after = t > CLOSURE
+    q = {}
+    for name, error in zip(("a", "b"), section_error):
+        # the closed valve's backflow reads the section's error instead of the synthetic leak
+        q[name] = (series.flow_rates[name] + np.where(after, Q_LEAK - TRUE_LEAK * 1e-6 + error, 0.0)) / 6
+    with h5py.File(folder / "fluid_probes.h5", "w") as f:
+        f["time"] = t.reshape(-1, 1)
+        f["pressure/upstream_tap"] = series.upstream_pressure.reshape(-1, 1)
+        f["pressure/downstream_tap"] = series.downstream_pressure.reshape(-1, 1)
+        for name, flow_rate in q.items():
+            f[f"flow_rate/{name}"] = flow_rate.reshape(-1, 1)
+        f["wall_force/fixed_walls"] = np.zeros((len(t), 3))
+    solid_times = np.arange(0.0, stop + 1e-9, SNAPSHOT_DT)
+    with h5py.File(folder / "solid_fields.h5", "w") as f:
+        f["mesh/nodes"] = scene.nodes
+        f["mesh/triangles"] = scene.triangles
+        for k, ts in enumerate(solid_times):
+            g = f.create_group(f"snapshots/{k:06d}")
+            g.attrs["time"] = ts + 1e-5          # a coupling window's end, not the fluid's step
+            g["position"] = leaflet_at(scene.nodes, ts)
+    write_particles(folder, scene, scene.times if particle_times is None else particle_times)
+    if log:
+        (folder / "fluid.log").write_text("[info] fluid_sph: coupled (3D) ...: 3650 fluid + 0 wall particles, "
+                                          f"195 interface nodes, dp = {SPACING} m, c0 = 20 m/s, 2 plate(s)\n")
+    return series
+
+
+def write_particles(folder: Path, scene: ValveScene, times):
+    with h5py.File(folder / "fluid_particles.h5", "w") as f:
+        for k, ts in enumerate(times):
+            x, kind = scene.snapshot(ts)
+            g = f.create_group(f"snapshot_{k:06d}")
+            g.attrs["time"] = ts
+            g["position"] = x
+            g["kind"] = kind
+            g["id"] = np.arange(len(x), dtype=np.uint32)
+
+
+class ValveLeak(unittest.TestCase):
+    STOP = CLOSURE + 5.5 * RING_PERIOD
+    TOLERANCE = 0.01             # mL/s
+
+    def scene(self):
+        return ValveScene(np.arange(CLOSURE - 0.02, self.STOP + 1e-9, SNAPSHOT_DT))
+
+    def analyse(self, folder, **kwargs):
+        series = hd.read_run(folder)
+        return series, hd.analyse_cycle(series, cycle=1, smoothing_s=0.0, closure_time_s=CLOSURE, allow_partial=True,
+                                        symmetry_factor=6, **kwargs)
+
+    def test_valve_side(self):
+        nodes, triangles = leaflet_mesh()
+        bulged = leaflet_at(nodes, CLOSURE)            # 1 mm down at the centre
+        points = np.array([[3e-3, 1e-3, 4.6e-3],       # under the flat leaflet
+                           [3e-3, 1e-3, 5.4e-3],       # over it
+                           [3e-3, 1e-3, 4.3e-3],       # over the bulged one (at 4.07 mm), under the flat
+                           [13e-3, 2e-3, 8e-3],        # the sinus, beyond the attachment radius
+                           [13e-3, 2e-3, 4e-3],        # beyond it and below the base: under the gasket
+                           [3e-3, 1e-3, -20e-3], [3e-3, 1e-3, 30e-3]])
+        for tris in (triangles, triangles[:, ::-1]):   # either orientation: the aorta is +z
+            flat = hd.valve_side(points, nodes, tris, VALVE_Z, VALVE_Z, VALVE_R)
+            self.assertEqual(flat.tolist(), [-1, 1, -1, 1, -1, -1, 1])
+            self.assertEqual(hd.valve_side(points, bulged, tris, VALVE_Z, VALVE_Z, VALVE_R).tolist(),
+                             [1, 1, 1, 1, -1, -1, 1])
+
+    def test_leak_by_particle_count_is_the_known_leak(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            scene = self.scene()
+            write_valve_run(Path(tmp), self.STOP, scene)
+            series, r = self.analyse(Path(tmp))
+        self.assertEqual(series.particle_spacing, SPACING)
+        self.assertIsNotNone(r.valve_leak, msg=r.valve_leak_refusal)
+        self.assertAlmostEqual(r.valve_leak.rate, TRUE_LEAK, delta=self.TOLERANCE)
+        self.assertLess(r.valve_leak.uncertainty, self.TOLERANCE)
+        # from where the flow sections' fit starts (one ringing period after the closure) to the end
+        self.assertAlmostEqual(r.valve_leak.start_s, r.leak.start_s, delta=SNAPSHOT_DT)
+        self.assertAlmostEqual(r.valve_leak.end_s, self.STOP, delta=SNAPSHOT_DT)
+        # the flow sections read the leak + their errors' mean, 1.5 mL/s: the fit finds that, not the leak
+        self.assertAlmostEqual(r.leak.rate, TRUE_LEAK + 1.5, delta=0.05)
+        # the leakage and the partial cycle's regurgitant volume use the leak through the valve
+        self.assertEqual(r.leakage_rate_source, "particles")
+        self.assertAlmostEqual(r.leakage_from_rate, r.valve_leak.rate * (T - CLOSURE), delta=1e-12)
+        self.assertAlmostEqual(r.regurgitant_volume, r.closing_volume + r.leakage_from_rate, delta=1e-12)
+        table = hd.hemodynamics_table({"valve": r})
+        self.assertIn(f"| {r.leakage_from_rate:.2f} ± {r.leakage_from_rate_uncertainty:.2f} (extrap.) (particles) |", table)
+        self.assertIn(f"| {r.valve_leak.rate:.2f} ± {r.valve_leak.uncertainty:.2f} (halves", table)
+
+    def test_joined_segments_later_wins(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            scene = self.scene()
+            joined, first, second = Path(tmp) / "joined", Path(tmp) / "s1", Path(tmp) / "s2"
+            write_valve_run(joined, self.STOP, scene, particle_times=[], log=False)
+            (joined / "fluid_particles.h5").unlink()
+            half = len(scene.times) // 2
+            split = scene.times[half]
+            first.mkdir(); second.mkdir()
+            write_particles(first, scene, scene.times[:half])
+            # the first segment went on past the second's start: its later snapshots (every particle in
+            # the aorta here) are not the run's
+            with h5py.File(first / "fluid_particles.h5", "a") as f:
+                n = len(f)
+                for k, ts in enumerate([split, split + SNAPSHOT_DT]):
+                    g = f.create_group(f"snapshot_{n + k:06d}")
+                    x, kind = scene.snapshot(ts)
+                    x[:, 2] = 0.05
+                    g.attrs["time"] = ts
+                    g["position"], g["kind"], g["id"] = x, kind, np.arange(len(x), dtype=np.uint32)
+            write_particles(second, scene, scene.times[half:])
+            (second / "fluid.log").write_text(f"... dp = {SPACING} m, c0 = 20 m/s\n")
+            (joined / "segments.json").write_text(json.dumps([str(first), str(second)]))
+            snapshots = hd.particle_snapshots(joined)
+            self.assertEqual(len(snapshots), len(scene.times))
+            _, r = self.analyse(joined)
+        self.assertIsNotNone(r.valve_leak, msg=r.valve_leak_refusal)
+        self.assertAlmostEqual(r.valve_leak.rate, TRUE_LEAK, delta=self.TOLERANCE)
+
+    def test_without_the_spacing_it_is_refused_or_given(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            write_valve_run(Path(tmp), self.STOP, self.scene(), log=False)
+            _, r = self.analyse(Path(tmp))
+            self.assertIsNone(r.valve_leak)
+            self.assertIn("particle spacing is unknown", r.valve_leak_refusal)
+            self.assertEqual(r.leakage_rate_source, "flow sections")
+            self.assertAlmostEqual(r.leakage_from_rate, r.leak.rate * (T - CLOSURE), delta=1e-12)
+            self.assertIn("No leak rate through the valve by particle count: valve: the particle spacing",
+                          hd.hemodynamics_table({"valve": r}))
+            _, given = self.analyse(Path(tmp), particle_spacing=SPACING)
+        self.assertAlmostEqual(given.valve_leak.rate, TRUE_LEAK, delta=self.TOLERANCE)
+
+    def test_too_few_snapshots_and_no_particles(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            scene = self.scene()
+            write_valve_run(Path(tmp), self.STOP, scene, particle_times=scene.times[::12])
+            _, r = self.analyse(Path(tmp))
+            self.assertIsNone(r.valve_leak)
+            self.assertRegex(r.valve_leak_refusal, r"^\d particle snapshots with the leaflets' between \d+ and \d+ ms, fewer than 6$")
+            without = hd.read_run(Path(tmp), particles=False)
+        self.assertIsNone(without.particle_run)
+        r = hd.analyse_cycle(without, cycle=1, smoothing_s=0.0, closure_time_s=CLOSURE, allow_partial=True)
+        self.assertIsNone(r.valve_leak)
+        self.assertEqual(r.valve_leak_refusal, "")
 
 if __name__ == "__main__":
     unittest.main()

@@ -119,15 +119,20 @@ class ProbeSeries:
 
 
 @dataclass
-class LeakRate:
-    """The closed valve's leak rate (leak_rate): whole valve, backflow positive, in the volume
-    units of CycleHemodynamics per second (mL/s; 2D cm^2/s)."""
+class FittedRate:
+    """A rate fitted over a span of the cycle, with its halves: whole valve, backflow positive, in
+    the volume units of CycleHemodynamics per second (mL/s; 2D cm^2/s)."""
     rate: float
     uncertainty: float              # half the difference between the two halves' rates
     first_half_rate: float
     second_half_rate: float
     start_s: float                  # the fitted span, s within the cycle
     end_s: float
+
+
+@dataclass
+class LeakRate(FittedRate):
+    """The closed valve's leak rate through the flow sections (leak_rate)."""
     period_s: float | None          # the ringing's period (None: no ringing found)
     decay_time_s: float | None      # e-folding time of its amplitude (inf: steady; < 0: it grows)
     ringing_volume: float           # its amplitude in the backflow volume at start_s (mL; 2D cm^2)
@@ -135,15 +140,8 @@ class LeakRate:
 
 
 @dataclass
-class ValveLeak:
-    """The leak through the closed valve by mass (valve_leak): whole valve, backflow positive, in
-    the volume units of CycleHemodynamics per second (mL/s)."""
-    rate: float
-    uncertainty: float              # half the difference between the two halves' rates
-    first_half_rate: float
-    second_half_rate: float
-    start_s: float                  # the fitted span, s within the cycle
-    end_s: float
+class ValveLeak(FittedRate):
+    """The leak through the closed valve by mass (valve_leak)."""
     snapshots: int                  # particle snapshots in the span
     volume_change: float            # the ventricle side's particle volume, last minus first snapshot (mL)
 

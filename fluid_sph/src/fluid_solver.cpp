@@ -506,11 +506,16 @@ template <int D>
 void FluidSolver<D>::shift_particles(double dt) {
   auto& p = particles_;
   const auto& s = settings_;
-  const double scale = s.shifting * s.smoothing_length() * max_speed_ * dt;
+  const double scale_per_speed = s.shifting * s.smoothing_length() * dt;
+  const bool own_speed = s.shifting_speed == FluidSettings<D>::ShiftingSpeed::own_speed;
   const double cap = s.max_shift_fraction * s.particle_spacing;
   const auto first = static_cast<std::ptrdiff_t>(owned_begin_), n = static_cast<std::ptrdiff_t>(owned_end_);
   const bool with_surface = surface_ != nullptr && near_surface_.size() == p.size();
   auto shift_of = [&](std::ptrdiff_t i) {
+    double speed2 = 0;
+    if (own_speed)
+      for (int d = 0; d < D; ++d) speed2 += static_cast<double>(p.velocity[d][i]) * p.velocity[d][i];
+    const double scale = scale_per_speed * (own_speed ? std::sqrt(speed2) : static_cast<double>(max_speed_));
     Vec<D> shift{};
     double length2 = 0;
     for (int d = 0; d < D; ++d) {

@@ -228,5 +228,20 @@ TEST(CaseSetup, ShiftingDensityCorrectionIsReadAndChecked) {
             std::string::npos) << what;
 }
 
+TEST(CaseSetup, ShiftingSpeedIsReadAndChecked) {
+  using Speed = FluidSettings<2>::ShiftingSpeed;
+  EXPECT_EQ(fluid_setup_from_case<2>(parse_case_text(kChannel, "channel.textproto"), "channel.textproto").settings.shifting_speed,
+            Speed::fastest_particle);  // the default
+  std::string own = kChannel;
+  own.replace(own.find("  probes {"), 0, "  shifting: 1\n  shifting_speed: SHIFT_BY_OWN_SPEED\n");
+  EXPECT_EQ(fluid_setup_from_case<2>(parse_case_text(own, "channel.textproto"), "channel.textproto").settings.shifting_speed,
+            Speed::own_speed);
+  std::string without_shifting = kChannel;
+  without_shifting.replace(without_shifting.find("  probes {"), 0, "  shifting_speed: SHIFT_BY_OWN_SPEED\n");
+  const std::string what = case_error(without_shifting);
+  EXPECT_NE(what.find("channel.textproto: field 'fluid.shifting_speed' = SHIFT_BY_OWN_SPEED, but shifting is 0"), std::string::npos)
+      << what;
+}
+
 }  // namespace
 }  // namespace valvefsi::fluid

@@ -46,13 +46,19 @@ struct FluidSettings {
   // catches a plate that the closing water hammer kicks away from the blood.
   bool plate_floor_once_reached = false;
   Vec<D> gravity{};                     // body acceleration (m/s^2)
-  // Particle shifting (Skillen et al. 2013 form): each step a fluid particle moves by
-  // -A h U dt grad C, with C the kernel sum, U the largest fluid speed and A this
-  // coefficient (0: off), capped at max_shift_fraction dp. It keeps the particle
-  // distribution regular where the flow stretches it (vortices, stagnation points, edges).
-  // Skipped near a free surface (C below free_surface_kernel_sum).
+  // Particle shifting: each step a fluid particle moves by -A h U dt grad C, with C the kernel
+  // sum, A this coefficient (0: off) and U a speed (shifting_speed), capped at
+  // max_shift_fraction dp. It keeps the particle distribution regular where the flow stretches
+  // it (vortices, stagnation points, edges). Skipped near a free surface (C below
+  // free_surface_kernel_sum).
   double shifting = 0.0;
   double max_shift_fraction = 0.05;
+  // U of the shift. fastest_particle: the largest fluid speed in the run, the same for every
+  // particle (robust where the fastest flow is, but fluid at rest moves wherever grad C is not
+  // 0, which a flow section counts as no flux). own_speed: the particle's own speed (Skillen et
+  // al. 2013), so fluid at rest stays put (docs/fluid_sph.md, "Shifting's speed").
+  enum class ShiftingSpeed { fastest_particle, own_speed };
+  ShiftingSpeed shifting_speed = ShiftingSpeed::fastest_particle;
   // What a shift does to the shifted particle's density (docs/fluid_sph.md, "Shifting and
   // density"). keep: nothing (the particles move, their density stays: where the shift spreads
   // particles apart their density ends above their packing). field_gradient: the particle takes

@@ -100,8 +100,13 @@ FluidSetup<D> fluid_setup_from_case(const cases::Case& c, const std::filesystem:
     case cases::FluidCase::SHIFT_CONTINUITY: s.shifting_density = FluidSettings<D>::ShiftingDensity::continuity; break;
     default: s.shifting_density = FluidSettings<D>::ShiftingDensity::keep; break;
   }
-  s.shifting_speed = f.shifting_speed() == cases::FluidCase::SHIFT_BY_OWN_SPEED ? FluidSettings<D>::ShiftingSpeed::own_speed
-                                                                                 : FluidSettings<D>::ShiftingSpeed::fastest_particle;
+  switch (f.shifting_speed()) {
+    case cases::FluidCase::SHIFT_BY_OWN_SPEED: s.shifting_speed = FluidSettings<D>::ShiftingSpeed::own_speed; break;
+    case cases::FluidCase::SHIFT_BY_OWN_SPEED_AWAY_FROM_LEAFLETS:
+      s.shifting_speed = FluidSettings<D>::ShiftingSpeed::own_speed_away_from_surfaces;
+      break;
+    default: s.shifting_speed = FluidSettings<D>::ShiftingSpeed::fastest_particle; break;
+  }
   if (f.has_shifting_speed() && s.shifting == 0)
     in.fail("shifting_speed", fmt::format("= {}, but shifting is 0: set shifting > 0 or remove it (no shift to scale)",
                                           cases::FluidCase::ShiftingSpeed_Name(f.shifting_speed())));

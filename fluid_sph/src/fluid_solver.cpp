@@ -507,11 +507,14 @@ void FluidSolver<D>::shift_particles(double dt) {
   auto& p = particles_;
   const auto& s = settings_;
   const double scale_per_speed = s.shifting * s.smoothing_length() * dt;
-  const bool own_speed = s.shifting_speed == FluidSettings<D>::ShiftingSpeed::own_speed;
+  using Speed = typename FluidSettings<D>::ShiftingSpeed;
   const double cap = s.max_shift_fraction * s.particle_spacing;
   const auto first = static_cast<std::ptrdiff_t>(owned_begin_), n = static_cast<std::ptrdiff_t>(owned_end_);
   const bool with_surface = surface_ != nullptr && near_surface_.size() == p.size();
-  auto shift_of = [&](std::ptrdiff_t i) {
+  // near: within a support of an immersed surface (the fastest speed there with
+  // own_speed_away_from_surfaces).
+  auto shift_of = [&](std::ptrdiff_t i, bool near) {
+    const bool own_speed = s.shifting_speed == Speed::own_speed || (s.shifting_speed == Speed::own_speed_away_from_surfaces && !near);
     double speed2 = 0;
     if (own_speed)
       for (int d = 0; d < D; ++d) speed2 += static_cast<double>(p.velocity[d][i]) * p.velocity[d][i];
@@ -533,7 +536,7 @@ void FluidSolver<D>::shift_particles(double dt) {
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t i = first; i < n; ++i) {
     if (!eligible(i) || (with_surface && near_surface_[static_cast<std::size_t>(i)])) continue;  // near: asked below
-    const Vec<D> shift = shift_of(i);
+    const Vec<D> shift = shift_of(i, false);
     for (int d = 0; d < D; ++d) shift_[d][i] = shift[d];
   }
   if (with_surface) {
@@ -541,7 +544,7 @@ void FluidSolver<D>::shift_particles(double dt) {
     // model keeps counters, so these calls stay on one thread.
     for (std::ptrdiff_t i = first; i < n; ++i) {
       if (!near_surface_[static_cast<std::size_t>(i)] || !eligible(i)) continue;
-      const Vec<D> shift = shift_of(i);
+      const Vec<D> shift = shift_of(i, true);
       if (!surface_->accept_shift(p, static_cast<std::size_t>(i), shift)) continue;
       for (int d = 0; d < D; ++d) shift_[d][i] = shift[d];
     }

@@ -232,10 +232,12 @@ TEST(CaseSetup, ShiftingSpeedIsReadAndChecked) {
   using Speed = FluidSettings<2>::ShiftingSpeed;
   EXPECT_EQ(fluid_setup_from_case<2>(parse_case_text(kChannel, "channel.textproto"), "channel.textproto").settings.shifting_speed,
             Speed::fastest_particle);  // the default
-  std::string own = kChannel;
-  own.replace(own.find("  probes {"), 0, "  shifting: 1\n  shifting_speed: SHIFT_BY_OWN_SPEED\n");
-  EXPECT_EQ(fluid_setup_from_case<2>(parse_case_text(own, "channel.textproto"), "channel.textproto").settings.shifting_speed,
-            Speed::own_speed);
+  for (const auto& [name, speed] : {std::pair{"SHIFT_BY_OWN_SPEED", Speed::own_speed},
+                                    std::pair{"SHIFT_BY_OWN_SPEED_AWAY_FROM_LEAFLETS", Speed::own_speed_away_from_surfaces}}) {
+    std::string text = kChannel;
+    text.replace(text.find("  probes {"), 0, std::string("  shifting: 1\n  shifting_speed: ") + name + "\n");
+    EXPECT_EQ(fluid_setup_from_case<2>(parse_case_text(text, "channel.textproto"), "channel.textproto").settings.shifting_speed, speed);
+  }
   std::string without_shifting = kChannel;
   without_shifting.replace(without_shifting.find("  probes {"), 0, "  shifting_speed: SHIFT_BY_OWN_SPEED\n");
   const std::string what = case_error(without_shifting);

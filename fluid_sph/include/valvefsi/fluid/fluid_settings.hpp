@@ -57,7 +57,9 @@ struct FluidSettings {
   // particle (robust where the fastest flow is, but fluid at rest moves wherever grad C is not
   // 0, which a flow section counts as no flux). own_speed: the particle's own speed (Skillen et
   // al. 2013), so fluid at rest stays put (docs/fluid_sph.md, "Shifting's speed").
-  enum class ShiftingSpeed { fastest_particle, own_speed };
+  // own_speed_away_from_surfaces: the fastest speed within a support of an immersed surface
+  // (the leaflets' slow layers need the regularisation), the own speed elsewhere.
+  enum class ShiftingSpeed { fastest_particle, own_speed, own_speed_away_from_surfaces };
   ShiftingSpeed shifting_speed = ShiftingSpeed::fastest_particle;
   // What a shift does to the shifted particle's density (docs/fluid_sph.md, "Shifting and
   // density"). keep: nothing (the particles move, their density stays: where the shift spreads

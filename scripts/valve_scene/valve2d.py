@@ -366,6 +366,9 @@ def fluid_block_2d(particle_spacing: float, cycles: int = CYCLES, channel: Chann
         f"  cfl: {FLUID_CFL_2D:g}",
         "  # shifting keeps the leaflets' free ends stable (docs/thin-leaflet.md)",
         "  shifting: 1",
+        "  # windows of whole fluid steps: -26 % of the cycle's fluid steps, metrics within the",
+        "  # scatter (docs/fsi-2d.md, session 19)",
+        "  fit_coupling_window_to_steps: true",
         *([f"  # the fluid starts at the aortic pressure at opening ({offset:g} mmHg): background pressure",
            "  # plus the plates' offset below, so neither plate starts with a step load",
            f"  background_pressure: {background_Pa:.9g}"] if background else

@@ -4,7 +4,10 @@
     through the crossing; held apart from itself the same restart ran to 1.6 s without a leak;
   - every coupled case holds the lower plate at the 20 mmHg floor once its drive has reached it
     (fluid.plate_pressure_floor_once_reached), so the diastolic ventricle's plate stays on the
-    blood from t = 0 without the start-up load the plain floor gave (88 N/m in 10 ms)."""
+    blood from t = 0 without the start-up load the plain floor gave (88 N/m in 10 ms);
+and session 19's: every coupled case fits its coupling windows to whole fluid steps (a cycle of
+the coarse FSI-MHGO valve: 184,614 -> 136,495 fluid steps, metrics within the scatter;
+docs/fsi-2d.md, "Session 19")."""
 import re
 import unittest
 from pathlib import Path
@@ -46,6 +49,12 @@ class CaseSettings2D(unittest.TestCase):
                 self.assertEqual(float(floor.group(1)), 20.0)
                 self.assertRegex(fluid, r"(?m)^\s*plate_pressure_floor_once_reached: true\s*$")
                 self.assertRegex(fluid, r"(?m)^\s*plates_never_pull: true\s*$")
+
+    def test_coupled_cases_fit_their_windows_to_whole_fluid_steps(self):
+        coupled = [p for p in self.cases() if "fsi-" in p.name]
+        for path in coupled:
+            with self.subTest(case=path.name):
+                self.assertRegex(block(path.read_text(), "fluid", path), r"(?m)^\s*fit_coupling_window_to_steps: true\s*$")
 
 
 if __name__ == "__main__":

@@ -41,4 +41,19 @@ double fluid_extent(const FluidSolver<D>& solver, int axis) {
   return best;
 }
 
+// A closed square box of blood (side `box`, from the origin): the settings of the shifting tests
+// (density diffusion 0.1, shifting 1, the domain 2 cm beyond the walls).
+inline FluidSettings<2> blood_box_settings(double box, double spacing, double sound_speed) {
+  FluidSettings<2> s;
+  s.particle_spacing = spacing;
+  s.rest_density = 1056.0;
+  s.dynamic_viscosity = 0.0035;
+  s.sound_speed = sound_speed;
+  s.density_diffusion = 0.1;
+  s.shifting = 1.0;
+  s.domain_lower = {-0.02, -0.02};
+  s.domain_upper = {box + 0.02, box + 0.02};
+  return s;
+}
+
 }  // namespace valvefsi::fluid::testing

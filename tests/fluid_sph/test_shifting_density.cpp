@@ -18,6 +18,7 @@
 #include <random>
 #include <vector>
 
+#include "test_helpers.hpp"
 #include "valvefsi/fluid/cell_grid.hpp"
 #include "valvefsi/fluid/fluid_solver.hpp"
 #include "valvefsi/fluid/geometry.hpp"
@@ -184,16 +185,8 @@ TEST(ShiftingDensity, SmoothingKeepsTheMeanAndDampsParticleScaleNoise) {
 // whose centre is pulled apart at t = 0 (radial velocity pulse, peak `speed`).
 double box_volume_error(Mode mode, double end) {
   const double L = 0.05, dp = L / 40, R = 0.008, speed = 1.0;
-  FluidSettings<2> s;
-  s.particle_spacing = dp;
-  s.rest_density = 1056.0;
-  s.dynamic_viscosity = 0.0035;
-  s.sound_speed = 10.0;
-  s.density_diffusion = 0.1;
-  s.shifting = 1.0;
+  FluidSettings<2> s = testing::blood_box_settings(L, dp, 10.0);
   s.shifting_density = mode;
-  s.domain_lower = {-0.02, -0.02};
-  s.domain_upper = {L + 0.02, L + 0.02};
   SceneGeometry<2> scene;
   scene.walls.push_back(container_box<2>({0.0, 0.0}, {L, L}));
   const Vec<2> centre{L / 2, L / 2};

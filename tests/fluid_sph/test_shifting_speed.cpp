@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "plane_surface.hpp"
+#include "test_helpers.hpp"
 #include "valvefsi/fluid/fluid_solver.hpp"
 #include "valvefsi/fluid/geometry.hpp"
 
@@ -36,16 +37,9 @@ constexpr double kBandX = 0.75 * kBox, kBandHalfWidth = 0.004;
 
 // shifting: coefficient A (0: off); with_band: a non-blocking plane surface at x = kBandX.
 Outcome run_box(double shifting, Speed speed, double end, bool with_band = false) {
-  FluidSettings<2> s;
-  s.particle_spacing = kSpacing;
-  s.rest_density = 1056.0;
-  s.dynamic_viscosity = 0.0035;
-  s.sound_speed = 20.0;
-  s.density_diffusion = 0.1;
+  FluidSettings<2> s = testing::blood_box_settings(kBox, kSpacing, 20.0);
   s.shifting = shifting;
   s.shifting_speed = speed;
-  s.domain_lower = {-0.02, -0.02};
-  s.domain_upper = {kBox + 0.02, kBox + 0.02};
   SceneGeometry<2> scene;
   scene.walls.push_back(container_box<2>({0.0, 0.0}, {kBox, kBox}));
   scene.fluid.push_back({{0.0, 0.0}, {kBox, kBox}, [](const Vec<2>& x) {

@@ -90,6 +90,17 @@ class CaseFiles(unittest.TestCase):
                 fluid = text[text.index("fluid {"):text.index("\n}\n", text.index("fluid {")) + 1]
                 self.assertIn("  fit_coupling_window_to_steps: true\n", fluid, spec.name)
 
+    def test_fsi_cases_shift_at_the_own_speed_away_from_the_leaflets(self):
+        # the fastest speed moved resting blood past the flow sections in diastole (docs/fsi-2d.md,
+        # docs/fsi-3d.md, session 19)
+        for spec in all_specs():
+            text = case_text(spec)
+            if spec.kind == "FE":
+                self.assertNotIn("shifting_speed", text, spec.name)
+            else:
+                fluid = text[text.index("fluid {"):text.index("\n}\n", text.index("fluid {")) + 1]
+                self.assertIn("  shifting_speed: SHIFT_BY_OWN_SPEED_AWAY_FROM_LEAFLETS\n", fluid, spec.name)
+
     def test_every_3d_case_has_the_stent_cylinder(self):
         for spec in all_specs():
             self.assertIn(f"contact_cylinders {{ origin: [0, 0, 0] axis: [0, 0, 1] radius: {stent_radius():.6g} }}", case_text(spec))

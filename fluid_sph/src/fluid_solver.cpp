@@ -511,10 +511,12 @@ void FluidSolver<D>::shift_particles(double dt) {
   const double cap = s.max_shift_fraction * s.particle_spacing;
   const auto first = static_cast<std::ptrdiff_t>(owned_begin_), n = static_cast<std::ptrdiff_t>(owned_end_);
   const bool with_surface = surface_ != nullptr && near_surface_.size() == p.size();
-  // near: within a support of an immersed surface (the fastest speed there with
-  // own_speed_away_from_surfaces).
+  // Which particles shift at their own speed: none, all, or those away from an immersed surface.
+  const bool own_speed_far = s.shifting_speed != Speed::fastest_particle;
+  const bool own_speed_near = s.shifting_speed == Speed::own_speed;
+  // near: within a support of an immersed surface.
   auto shift_of = [&](std::ptrdiff_t i, bool near) {
-    const bool own_speed = s.shifting_speed == Speed::own_speed || (s.shifting_speed == Speed::own_speed_away_from_surfaces && !near);
+    const bool own_speed = near ? own_speed_near : own_speed_far;
     double speed2 = 0;
     if (own_speed)
       for (int d = 0; d < D; ++d) speed2 += static_cast<double>(p.velocity[d][i]) * p.velocity[d][i];

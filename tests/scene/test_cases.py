@@ -80,26 +80,24 @@ class CaseFiles(unittest.TestCase):
                 # the solid program refuses it when coupled: the fluid damps the valve
                 self.assertNotIn("diastolic", solid, spec.name)
 
-    def test_fsi_cases_fit_their_coupling_windows_to_whole_fluid_steps(self):
-        # a window of 2.06 fluid steps costs 3 (fluid.fit_coupling_window_to_steps, docs/fsi-3d.md)
+    def assert_fluid_line_only_in_fsi_cases(self, field: str, line: str):
+        """FE-only cases do not name `field`; every FSI case's fluid block has `line`."""
         for spec in all_specs():
             text = case_text(spec)
             if spec.kind == "FE":
-                self.assertNotIn("fit_coupling_window_to_steps", text, spec.name)
+                self.assertNotIn(field, text, spec.name)
             else:
                 fluid = text[text.index("fluid {"):text.index("\n}\n", text.index("fluid {")) + 1]
-                self.assertIn("  fit_coupling_window_to_steps: true\n", fluid, spec.name)
+                self.assertIn(f"  {line}\n", fluid, spec.name)
+
+    def test_fsi_cases_fit_their_coupling_windows_to_whole_fluid_steps(self):
+        # a window of 2.06 fluid steps costs 3 (fluid.fit_coupling_window_to_steps, docs/fsi-3d.md)
+        self.assert_fluid_line_only_in_fsi_cases("fit_coupling_window_to_steps", "fit_coupling_window_to_steps: true")
 
     def test_fsi_cases_shift_at_the_own_speed_away_from_the_leaflets(self):
         # the fastest speed moved resting blood past the flow sections in diastole (docs/fsi-2d.md,
         # docs/fsi-3d.md, session 19)
-        for spec in all_specs():
-            text = case_text(spec)
-            if spec.kind == "FE":
-                self.assertNotIn("shifting_speed", text, spec.name)
-            else:
-                fluid = text[text.index("fluid {"):text.index("\n}\n", text.index("fluid {")) + 1]
-                self.assertIn("  shifting_speed: SHIFT_BY_OWN_SPEED_AWAY_FROM_LEAFLETS\n", fluid, spec.name)
+        self.assert_fluid_line_only_in_fsi_cases("shifting_speed", "shifting_speed: SHIFT_BY_OWN_SPEED_AWAY_FROM_LEAFLETS")
 
     def test_every_3d_case_has_the_stent_cylinder(self):
         for spec in all_specs():

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include <Eigen/Dense>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -49,7 +50,36 @@ struct ExplicitSolver::ImplicitWork {
   Eigen::Matrix3Xd external_before_window;
   bool window_first_step = false;
   Eigen::VectorXd delta;
+  // The plane and stent springs the factorised tangent holds (one per node: in contact when it was
+  // built, and the spring's direction), and the present iterate's. A kept tangent whose set differs
+  // is given the iterate's springs by a low-rank (Woodbury) update of its solves instead of a new
+  // factorisation (docs/solid_fe.md, "Twentieth session").
+  std::vector<std::uint8_t> tangent_in_contact, iterate_in_contact;
+  Eigen::Matrix3Xd tangent_direction, iterate_direction;
+  struct SpringColumn {
+    std::int32_t node = 0;
+    bool add = true;              // + the iterate's spring the tangent lacks, - the tangent's the iterate lacks
+    Eigen::Vector3d u;            // the spring's direction, projected by the node's constraints
+    Eigen::VectorXd solved;       // the kept tangent's solve of the spring's column
+  };
+  std::vector<SpringColumn> spring_columns;  // the update's columns; valid for the present factorisation
+  Eigen::MatrixXd capacitance;
+  Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_lu;
 };
+
+namespace {
+// Above this many changed springs a new factorisation is cheaper than the update's solves (one
+// solve per spring; the fine sector's factorisation costs ~70 solves).
+constexpr int kMaxSpringUpdate = 64;
+
+// Whether a Newton iteration converging at the observed rate (residual / previous) would need more
+// than `fast` iterations in all to reach `tolerance` (the step would then not grow).
+bool too_slow_to_grow(int iteration, double residual, double previous, double tolerance, int fast) {
+  const double rate = residual / previous;
+  if (!(rate < 1.0)) return true;
+  return iteration + std::log(tolerance / residual) / std::log(rate) > fast;
+}
+}  // namespace
 
 void ExplicitSolver::prepare_implicit() {
   if (planar_ || tie_) {
@@ -111,6 +141,7 @@ bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_force
   const double round_off = 1e-12 * (reference.rowwise().maxCoeff() - reference.rowwise().minCoeff()).norm();
   double correction = std::numeric_limits<double>::infinity();
   double previous_residual = std::numeric_limits<double>::infinity();
+  bool built_this_step = false;
   for (int iteration = 0;; ++iteration) {
     state_.position = x_n + w.dx;
     state_.time = t_new;
@@ -147,17 +178,29 @@ bool ExplicitSolver::implicit_step(double h, const Eigen::Matrix3Xd* nodal_force
       w.factor_valid = false;  // the retry starts from a fresh tangent
       return fail();
     }
-    // A kept tangent is refreshed when it was built for another step size or when the residual
-    // fell by less than 4x in the last iteration with it.
+    const bool set_changed = update_iterate_contact_set(iteration == 0);
+    // A kept tangent is refreshed when it was built for another step size or damping; when the
+    // residual fell by less than 4x in the last iteration with it, unless the plane and stent
+    // contact set changed in that iteration (the spring update below covers the contact; a flip
+    // costs an iteration, not the tangent); and once per step when a tangent kept from an earlier
+    // step converges too slowly for the step to grow. (Measured on the fine sector: a kept tangent
+    // whose contact set had gone stale converged linearly at 0.15-0.19 per iteration, below the 4x
+    // test, so it was never rebuilt and every step took 6 iterations: the step neither grew nor
+    // shrank; docs/solid_fe.md, "Twentieth session".)
+    const bool slow = iteration > 0 && residual > 0.25 * previous_residual && !set_changed;
+    const bool stale = iteration > 0 && !built_this_step && !set_changed &&
+                       too_slow_to_grow(iteration, residual, previous_residual, options_.newton_tolerance,
+                                        options_.newton_fast_iterations);
     const bool refresh = !w.factor_valid || std::abs(w.factor_step - h) > 1e-9 * h || w.factor_damping != damping ||
-                         (iteration > 0 && residual > 0.25 * previous_residual);
+                         slow || stale;
     previous_residual = residual;
-    if (refresh) {
+    if (refresh || !prepare_spring_update(stiffness_coefficient)) {
       if (!factorise_tangent(h, t_new, mass_coefficient, stiffness_coefficient)) return fail();
       w.factor_damping = damping;
+      built_this_step = true;
     }
     w.delta = w.lu.solve(-Eigen::Map<const Eigen::VectorXd>(w.r.data(), 3 * n));
-    if (w.lu.info() != Eigen::Success || !w.delta.allFinite()) {
+    if (w.lu.info() != Eigen::Success || !w.delta.allFinite() || !apply_spring_update(w.delta)) {
       w.factor_valid = false;
       return fail();
     }
@@ -205,11 +248,16 @@ bool ExplicitSolver::factorise_tangent(double h, double t_new, double mass_coeff
     // full valve's steps to a few us; docs/solid_fe.md, "Thirteenth session").
     const double penalty = options_.contact_stiffness_factor * state_.contact_omega2;
     const Eigen::Matrix3Xd& own = leaflet_contact_ ? own_contact_force_ : state_.contact_force;
+    w.tangent_in_contact.assign(static_cast<std::size_t>(n), 0);
+    w.tangent_direction.setZero(3, n);
+    w.spring_columns.clear();
     for (Eigen::Index i = 0; i < n; ++i) {
       const auto node = static_cast<std::int32_t>(i);
       const double f = own.col(i).norm();
       if (f > 0.0) {
         const Eigen::Vector3d u = own.col(i) / f;
+        w.tangent_in_contact[static_cast<std::size_t>(i)] = 1;
+        w.tangent_direction.col(i) = u;
         add_block(node, node, (stiffness_coefficient * penalty * mass(i)) * (u * u.transpose()));
       }
       add_block(node, node, Eigen::Matrix3d::Zero());  // keeps the pattern whether in contact or not
@@ -246,6 +294,91 @@ bool ExplicitSolver::factorise_tangent(double h, double t_new, double mass_coeff
   w.factor_valid = true;
   w.factor_step = h;
   return true;
+}
+
+bool ExplicitSolver::update_iterate_contact_set(bool first_iterate) {
+  ImplicitWork& w = *implicit_;
+  const Eigen::Index n = state_.position.cols();
+  const Eigen::Matrix3Xd& own = leaflet_contact_ ? own_contact_force_ : state_.contact_force;
+  bool changed = false;
+  if (first_iterate || w.iterate_in_contact.size() != static_cast<std::size_t>(n)) {
+    w.iterate_in_contact.assign(static_cast<std::size_t>(n), 0);
+    w.iterate_direction.setZero(3, n);
+    first_iterate = true;
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double f = own.col(i).norm();
+    const std::uint8_t in = f > 0.0 ? 1 : 0;
+    changed = changed || in != w.iterate_in_contact[k];
+    w.iterate_in_contact[k] = in;
+    if (in) w.iterate_direction.col(i) = own.col(i) / f;
+  }
+  return changed && !first_iterate;
+}
+
+bool ExplicitSolver::prepare_spring_update(double stiffness_coefficient) {
+  ImplicitWork& w = *implicit_;
+  const Eigen::Index n = state_.position.cols();
+  const Eigen::VectorXd& mass = elements_->nodal_mass();
+  const double penalty = options_.contact_stiffness_factor * state_.contact_omega2;
+  if (w.tangent_in_contact.size() != static_cast<std::size_t>(n)) return false;
+  // The springs the iterate has and the tangent lacks (+), and the reverse (-): exactly the
+  // difference of the two contact parts, k u u^T per node, projected like the tangent's blocks.
+  std::vector<ImplicitWork::SpringColumn> columns;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const bool now = w.iterate_in_contact[k] != 0;
+    if (now == (w.tangent_in_contact[k] != 0)) continue;
+    if (static_cast<int>(columns.size()) >= kMaxSpringUpdate) return false;
+    ImplicitWork::SpringColumn c;
+    c.node = static_cast<std::int32_t>(i);
+    c.add = now;
+    c.u = now ? Eigen::Vector3d(w.iterate_direction.col(i)) : Eigen::Vector3d(w.tangent_direction.col(i));
+    if (w.constrained[k]) c.u = w.projector[k] * c.u;
+    const auto cached = std::ranges::find_if(w.spring_columns, [&](const ImplicitWork::SpringColumn& s) {
+      return s.node == c.node && s.add == c.add && s.u == c.u;
+    });
+    if (cached != w.spring_columns.end()) {
+      c.solved = std::move(cached->solved);
+    } else {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(3 * n);
+      e.segment<3>(3 * i) = c.u;
+      c.solved = w.lu.solve(e);
+      if (w.lu.info() != Eigen::Success || !c.solved.allFinite()) return false;
+      w.pending_work += 1.0;  // a solve: about a force evaluation
+    }
+    columns.push_back(std::move(c));
+  }
+  w.spring_columns = std::move(columns);
+  // (K + U C U^T)^-1 = K^-1 - K^-1 U (C^-1 + U^T K^-1 U)^-1 U^T K^-1, C = diag(+-(1 - alpha_f) k_i).
+  const auto r = static_cast<Eigen::Index>(w.spring_columns.size());
+  if (r == 0) return true;
+  w.capacitance.resize(r, r);
+  for (Eigen::Index a = 0; a < r; ++a) {
+    const ImplicitWork::SpringColumn& ca = w.spring_columns[static_cast<std::size_t>(a)];
+    for (Eigen::Index b = 0; b < r; ++b) {
+      w.capacitance(a, b) = ca.u.dot(w.spring_columns[static_cast<std::size_t>(b)].solved.segment<3>(3 * ca.node));
+    }
+    const double spring = stiffness_coefficient * penalty * mass(ca.node);
+    w.capacitance(a, a) += ca.add ? 1.0 / spring : -1.0 / spring;
+  }
+  w.capacitance_lu.compute(w.capacitance);
+  return w.capacitance_lu.rcond() > 1e-12;
+}
+
+bool ExplicitSolver::apply_spring_update(Eigen::VectorXd& solved) const {
+  const ImplicitWork& w = *implicit_;
+  const auto r = static_cast<Eigen::Index>(w.spring_columns.size());
+  if (r == 0) return true;
+  Eigen::VectorXd projected(r);
+  for (Eigen::Index a = 0; a < r; ++a) {
+    const ImplicitWork::SpringColumn& c = w.spring_columns[static_cast<std::size_t>(a)];
+    projected(a) = c.u.dot(solved.segment<3>(3 * c.node));
+  }
+  const Eigen::VectorXd z = w.capacitance_lu.solve(projected);
+  for (Eigen::Index a = 0; a < r; ++a) solved -= z(a) * w.spring_columns[static_cast<std::size_t>(a)].solved;
+  return solved.allFinite();
 }
 
 bool ExplicitSolver::finish_implicit_step(const SolverState& start, double h) {

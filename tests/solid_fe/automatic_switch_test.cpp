@@ -142,14 +142,17 @@ TEST(AutomaticSwitch, FilteredKineticEnergySwitchesEarlierWithTheSameAnswer) {
               static_cast<long long>(reference.steps_at_ms.back()));
   // Implicit 5 ms after the flap lies still (measured 7.15 ms; instantaneous 26.88 ms). It may come
   // back to explicit while pressed when the instantaneous energy rises again after the implicit
-  // scheme had damped it (measured: 17.79 -> 22.80 ms), but the last switch is the release's,
+  // scheme had damped it (measured: 16.13 -> 21.14 ms), but the last switch is the release's,
   // caught as early as without the filter (measured 60.09 ms).
   EXPECT_GT(filtered.switch_times[0], 5e-3);
   EXPECT_LT(filtered.switch_times[0], instantaneous.switch_times[0] - 10e-3);
   EXPECT_EQ(filtered.switch_times.size() % 2, 0u);
   EXPECT_LT(filtered.switch_times[filtered.switch_times.size() - 2], kRelease);
   EXPECT_GE(filtered.switch_times.back(), kRelease);
-  EXPECT_LE(filtered.switch_times.back(), instantaneous.switch_times[1] + 1e-9);
+  // Within a microsecond: the back-switch is seen after an implicit step, and since the twentieth
+  // session's kept-tangent rules the two runs' steps near the release differ (measured 60.0949 ms
+  // against 60.0945 ms; before, equal to 1e-9).
+  EXPECT_LE(filtered.switch_times.back(), instantaneous.switch_times[1] + 1e-6);
   // Bounds: 2 % of the thickness pressed (as above; measured 0.024 um). Released 1 % (2.5 um;
   // measured 0.49 um, the instantaneous switch 0.66 um), 160x below the 0.41 mm travel. Why half the
   // step: after the release every run integrates explicitly, and at the default safety 0.8 the

@@ -344,6 +344,13 @@ class ExplicitSolver {
   void prepare_implicit();
   // Builds and factorises the step's tangent at the present trial state (false if it cannot).
   bool factorise_tangent(double h, double t_new, double mass_coefficient, double stiffness_coefficient);
+  // The present Newton iterate's plane and stent contact set (true: it changed since the last
+  // iterate of the step), and the low-rank update that gives a kept factorisation that set's
+  // springs: prepared (false: too many changed springs or singular; refactorise) and applied to
+  // a solve's result.
+  bool update_iterate_contact_set(bool first_iterate);
+  bool prepare_spring_update(double stiffness_coefficient);
+  bool apply_spring_update(Eigen::VectorXd& solved) const;
   // Books a converged step from `start` (velocity, acceleration, energies).
   bool finish_implicit_step(const SolverState& start, double h);
   // Automatic switch's cost rule (options_.implicit_tangent_cost): books an accepted implicit

@@ -102,6 +102,8 @@ class ProbeSeries:
     particle_run: Path | None = None        # 3D: the run whose particle and leaflet snapshots give the
                                             # leak through the valve (valve_leak), or None
     particle_spacing: float | None = None   # m: its particles' spacing (volume dp^3 each), or None
+    tip_gap_time: np.ndarray | None = None  # 2D: solid sample times (s) of tip_gap, or None
+    tip_gap: np.ndarray | None = None       # 2D: distance between the two leaflets' tips (m), or None
 
     @property
     def mean_flow_rate(self) -> np.ndarray:
@@ -188,6 +190,10 @@ class CycleHemodynamics:
     valve_leak: ValveLeak | None = None            # the leak through the valve by particle count (3D)
     valve_leak_refusal: str = ""                   # why there is none (empty: not attempted or measured)
     leakage_rate_source: str = ""                  # "particles" (valve_leak) or "flow sections" (leak)
+    tip_gap_mm: float | None = None                # 2D: the tips' mean distance from the closure to the
+                                                   # series' end (mm), or None
+    tip_gap_orifice_leakage: float | None = None   # 2D: the orifice law's backflow through that gap
+                                                   # over the same span (cm^2 per cm; tip_gap_orifice_flow)
 
 
 def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "downstream_tap",
@@ -246,6 +252,14 @@ def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "d
                 axis = 2 if series.dimension == 3 else 0
                 series.force_time = f["time"][()].reshape(-1)
                 series.axial_force = f["force_fluid"][()][:, axis]
+    solid_series = run_dir / "solid_series.h5"
+    if series.dimension == 2 and solid_series.exists():
+        with h5py.File(solid_series, "r") as f:
+            key = "monitor/free_edge_midpoints/position"
+            if key in f and f[key].ndim == 3 and f[key].shape[1] == 2 and len(f["time"]):
+                tips = f[key][()]
+                series.tip_gap_time = f["time"][()].reshape(-1)
+                series.tip_gap = np.linalg.norm(tips[:, 0, :2] - tips[:, 1, :2], axis=1)
     if particles and series.dimension == 3 and (run_dir / "solid_fields.h5").exists() and particle_snapshots(run_dir):
         series.particle_run = run_dir
         series.particle_spacing = particle_spacing_of(run_dir)
@@ -412,6 +426,26 @@ def valve_leak(series: ProbeSeries, closure: float, end: float, start: float, to
     return ValveLeak(rate=rate, uncertainty=0.5 * abs(halves[0] - halves[1]), first_half_rate=halves[0],
                      second_half_rate=halves[1], start_s=float(times[0] - cycle_start), end_s=float(times[-1] - cycle_start),
                      snapshots=len(times), volume_change=float(volume[-1] - volume[0])), ""
+
+
+# ---------------------------------------------------------------------------------------------
+# The 2D valve's tips' gap as an orifice
+
+
+BLOOD_DENSITY = 1056.0             # kg/m^3, the cases' fluid density
+SLIT_DISCHARGE_COEFFICIENT = 0.6   # a sharp-edged slit's (0.6-0.62); the coarse 2D valve's SPH
+                                   # leakage follows it at gaps of 0.16-0.49 mm (docs/fsi-2d.md, session 20)
+
+
+def tip_gap_orifice_flow(t: np.ndarray, pressure_drop_Pa: np.ndarray, gap_time: np.ndarray, gap_m: np.ndarray,
+                         density: float = BLOOD_DENSITY,
+                         discharge: float = SLIT_DISCHARGE_COEFFICIENT) -> np.ndarray:
+    """Flow per depth (m^2/s, forward positive) that the orifice law passes through a slit as wide
+    as the 2D valve's tips are apart, Q = C_d g sqrt(2 |dp| / rho) sign(dp), on the probe times t
+    (the gap interpolated onto them). Compared with the flow sections, it says how much of a
+    closed 2D valve's leakage is flow through the gap its tips leave."""
+    gap = np.interp(t, gap_time, gap_m)
+    return discharge * gap * np.sqrt(2.0 * np.abs(pressure_drop_Pa) / density) * np.sign(pressure_drop_Pa)
 
 
 def moving_average(t: np.ndarray, y: np.ndarray, width_s: float) -> np.ndarray:
@@ -698,6 +732,13 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
     leakage_from_rate_uncertainty = None if chosen is None else chosen.uncertainty * (end - t_close)
     extrapolated = partial and leakage_from_rate is not None
     peak_q = float(np.max(q)) * to_volume
+    tip_gap_mm = tip_gap_leakage = None
+    if series.tip_gap is not None and series.tip_gap_time is not None and t[-1] > t_close:
+        closed = (series.tip_gap_time >= t_close) & (series.tip_gap_time <= t[-1])
+        if np.any(closed):
+            tip_gap_mm = float(np.mean(series.tip_gap[closed])) * 1e3
+            orifice = tip_gap_orifice_flow(t, dp, series.tip_gap_time, series.tip_gap)
+            tip_gap_leakage = -integral(t, orifice, t_close, t[-1]) * to_volume
     sections = {name: integral(t, rate[sel] * symmetry_factor, t1, t2) * to_volume for name, rate in series.flow_rates.items()}
 
     velocity = velocity_time = particle_speed = None
@@ -740,7 +781,7 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
         leak=leak, leak_refusal=leak_refusal, leakage_from_rate=leakage_from_rate,
         leakage_from_rate_uncertainty=leakage_from_rate_uncertainty,
         regurgitant_extrapolated=extrapolated, valve_leak=valve, valve_leak_refusal=valve_refusal,
-        leakage_rate_source=source)
+        leakage_rate_source=source, tip_gap_mm=tip_gap_mm, tip_gap_orifice_leakage=tip_gap_leakage)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -843,6 +884,12 @@ def hemodynamics_table(results: dict) -> str:
         ("water-hammer ratio", lambda r: _f(r.water_hammer_ratio, 2), [ref_ratio(r) for r in refs]),
         ("forward flow (ms)", lambda r: f"{r.forward_start_s * 1e3:.0f}–{r.forward_end_s * 1e3:.0f}", ["–"] * len(refs)),
     ]
+    if any(r.tip_gap_mm is not None for r in results.values()):
+        at = next(i for i, row in enumerate(spec) if row[0].startswith("— leak rate, backflow"))
+        spec[at:at] = [
+            ("— 2D: the tips' gap, mean from the closure to the series' end (mm)", lambda r: _f(r.tip_gap_mm, 3), none),
+            (f"— 2D: the orifice law through that gap, C_d {SLIT_DISCHARGE_COEFFICIENT:g}, over the same span "
+             f"({u['volume']})", lambda r: _f(r.tip_gap_orifice_leakage, 2), none)]
     if partial:
         spec.append(("partial cycle: series ends at (ms); leakage to it, diastolic force up to it",
                      lambda r: _f(r.series_end_s, 0, 1e3), none))

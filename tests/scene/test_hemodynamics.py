@@ -1,7 +1,7 @@
 """Hemodynamics (issue 7, item 3) on synthetic probe series with known answers: a half-sine
 ejection (known rms and volume), a known pressure drop, a closing backflow plus a constant
-leak (known regurgitant volume), a known leaflet force, two cycles, 2D units, and the HDF5
-layouts of fluid_sph and the coupler."""
+leak (known regurgitant volume), a known leaflet force, two cycles, 2D units (and the 2D tips'
+gap as an orifice), and the HDF5 layouts of fluid_sph, the coupler and the solid."""
 import json
 import math
 import tempfile
@@ -211,6 +211,29 @@ class TwoDimensional(unittest.TestCase):
         self.assertAlmostEqual(r2.hydrostatic_force, -hd.hydrostatic_pressure_Pa() * 0.023, delta=1e-9)
         self.assertAlmostEqual(r2.hydrostatic_force, -298.1, delta=0.5)
         self.assertIn("cm per cm depth", hd.hemodynamics_table({"2D": r2}))
+        self.assertIsNone(r2.tip_gap_mm)
+        self.assertNotIn("tips' gap", hd.hemodynamics_table({"2D": r2}))
+
+    def test_tips_gap_as_an_orifice(self):
+        # tips 0.4 mm apart (ringing +-0.1 mm) under the -80 mmHg of the closed valve: the slit
+        # passes C_d g sqrt(2 |dp| / rho) per depth from the closure to the cycle's end
+        series = synthetic(dimension=2)
+        series.tip_gap_time = np.arange(0, 2 * T + 1e-9, 1e-4)
+        series.tip_gap = 0.4e-3 + 0.1e-3 * np.sin(2 * np.pi * 300.0 * series.tip_gap_time)
+        r = hd.analyse_cycle(series, cycle=1, smoothing_s=0.0)
+        self.assertAlmostEqual(r.tip_gap_mm, 0.4, delta=2e-3)
+        speed = math.sqrt(2 * 80 * MMHG / hd.BLOOD_DENSITY)            # 4.49 m/s
+        expected = hd.SLIT_DISCHARGE_COEFFICIENT * 0.4e-3 * speed * (T - r.closure_time_s) * 1e4
+        self.assertAlmostEqual(r.tip_gap_orifice_leakage, expected, delta=0.01 * expected)
+        self.assertGreater(r.tip_gap_orifice_leakage, 5.0)               # cm^2 per cm: ~5.6
+        table = hd.hemodynamics_table({"2D": r})
+        self.assertIn("the tips' gap", table)
+        self.assertIn(f"{r.tip_gap_orifice_leakage:.2f}", table)
+        # forward flow through an open slit counts forward (sign of dp)
+        q = hd.tip_gap_orifice_flow(np.array([0.0, 1.0]), np.array([8 * MMHG, -8 * MMHG]), np.array([0.0, 1.0]),
+                                    np.array([1e-3, 1e-3]))
+        self.assertAlmostEqual(q[0], -q[1], delta=1e-15)
+        self.assertGreater(q[0], 0.0)
 
 
 class Files(unittest.TestCase):
@@ -243,6 +266,23 @@ class Files(unittest.TestCase):
             b = hd.analyse_cycle(series, smoothing_s=0.0)
             self.assertAlmostEqual(a.eoa, b.eoa, delta=1e-12)
             self.assertAlmostEqual(a.diastolic_force, b.diastolic_force, delta=1e-12)
+
+    def test_2d_run_reads_the_tips_gap_from_the_solid_series(self):
+        series = synthetic(dimension=2)
+        with tempfile.TemporaryDirectory() as tmp:
+            folder = Path(tmp)
+            self.write_run(folder, series)
+            ts = np.arange(0, 2 * T + 1e-9, 1e-3)
+            tips = np.zeros((len(ts), 2, 3))
+            tips[:, 0, 1], tips[:, 1, 1] = 0.15e-3, -0.15e-3      # 0.3 mm apart across the axis
+            tips[:, :, 2] = 0.5e-3                                  # the strip's depth does not count
+            with h5py.File(folder / "solid_series.h5", "w") as f:
+                f["time"] = ts
+                f["monitor/free_edge_midpoints/position"] = tips
+            read = hd.read_run(folder)
+            np.testing.assert_allclose(read.tip_gap, 0.3e-3, atol=1e-12)
+            r = hd.analyse_cycle(read, cycle=1, smoothing_s=0.0)
+            self.assertAlmostEqual(r.tip_gap_mm, 0.3, delta=1e-9)
 
     def test_chosen_sections_are_averaged(self):
         with tempfile.TemporaryDirectory() as tmp:

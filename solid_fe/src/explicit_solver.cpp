@@ -684,7 +684,7 @@ void ExplicitSolver::switch_to_explicit() {
   compute_contact_force();
 }
 
-void ExplicitSolver::check_energy_growth() const {
+double ExplicitSolver::energy_growth_measure() const {
   const EnergyBalance& e = state_.energy;
   // Relative to the largest energy seen, but never to less than the model's energy floor: below
   // it the ledger holds round-off-sized energies whose relative error means nothing (a coupled
@@ -695,7 +695,12 @@ void ExplicitSolver::check_energy_growth() const {
   // energy on their own (negative dissipation beyond the part from the loads' window steps, which
   // is the coupling's exchange and is watched by the coupler): that counts as growth too.
   const double scheme_created = std::max(0.0, e.load_step_dissipation - e.numerical_dissipation);
-  const double error = std::max(std::abs(e.balance()), scheme_created) / scale;
+  return std::max(std::abs(e.balance()), scheme_created) / scale;
+}
+
+void ExplicitSolver::check_energy_growth() const {
+  const EnergyBalance& e = state_.energy;
+  const double error = energy_growth_measure();
   if (error <= options_.max_energy_balance_error) return;  // (a NaN balance stops too)
   // Where the kinetic energy sits: the node with the most, and its share of the total.
   const Eigen::VectorXd& mass = elements_->nodal_mass();

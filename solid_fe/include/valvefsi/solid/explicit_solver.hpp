@@ -290,6 +290,10 @@ class ExplicitSolver {
   const SolverState& state() const { return state_; }
   // The energy-growth check's smallest scale (J): the strain energy at kEnergyFloorStrain.
   double energy_check_floor() const { return energy_check_floor_; }
+  // What the energy-growth stop compares with solver.max_energy_balance_error: max(|balance|,
+  // energy the implicit scheme created beyond the loads' window steps) over the largest energy
+  // seen, at least the model's floor. The progress lines print it.
+  double energy_growth_measure() const;
   void restore(const SolverState& saved) {
     state_ = saved;
     internal_force_current_ = true;

@@ -62,6 +62,7 @@ from pathlib import Path
 import numpy as np
 
 from . import waveform
+from .tube_case import BLOOD_DENSITY
 
 PA_PER_MMHG = 133.322387415
 GORLIN_CONSTANT = 51.6        # cm/s per sqrt(mmHg), with Q in mL/s -> EOA in cm^2
@@ -432,7 +433,6 @@ def valve_leak(series: ProbeSeries, closure: float, end: float, start: float, to
 # The 2D valve's tips' gap as an orifice
 
 
-BLOOD_DENSITY = 1056.0             # kg/m^3, the cases' fluid density
 SLIT_DISCHARGE_COEFFICIENT = 0.6   # a sharp-edged slit's (0.6-0.62); the coarse 2D valve's SPH
                                    # leakage follows it at gaps of 0.16-0.49 mm (docs/fsi-2d.md, session 20)
 

@@ -25,6 +25,14 @@ ThinWallCase2D two_level_tank(double dp, double left_level, double right_level, 
   return c;
 }
 
+ThinWallCase2D two_level_tank_with_joint(double dp, double left_level, double right_level, double joint, double gap) {
+  ThinWallCase2D c = two_level_tank(dp, left_level, right_level, 0.0);
+  c.walls.clear();
+  c.walls.push_back(Polyline::at_rest({{0.5, -3.0 * dp}, {0.5, joint - gap / 2}}));
+  c.walls.push_back(Polyline::at_rest({{0.5, joint + gap / 2}, {0.5, 1.2}}));
+  return c;
+}
+
 ThinWallCase2D oscillating_plate_box(double dp, const OscillatingPlate& plate) {
   ThinWallCase2D c;
   auto& s = c.fluid;

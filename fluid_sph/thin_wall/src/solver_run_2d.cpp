@@ -26,7 +26,7 @@ ThinWallSolverRun2D::ThinWallSolverRun2D(ThinWallCase2D c, double window)
   if (c.walls.empty()) throw std::invalid_argument("ThinWallSolverRun2D: the case has no thin wall");
   if (motion_) motion_(0.0, c.walls);
   const ImmersedSurfaceGeometry<2> g = surface_of(c.walls);
-  auto model = std::make_unique<ThinWallModel2D>(g, c.fluid, c.wall_settings);
+  auto model = std::make_unique<ThinWallModel2D>(g, c.fluid, c.wall_settings, c.coaptation_distance);
   model_ = model.get();
   solver_ = std::make_unique<FluidSolver<2>>(c.fluid, fill_particles<2>(c.scene, c.fluid), std::vector<PressurePlate<2>>{},
                                              std::move(model));

@@ -1,6 +1,7 @@
 #include "valvefsi/fluid/thin_wall/thin_wall_model.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
@@ -65,13 +66,17 @@ std::vector<std::vector<std::uint32_t>> chains_from_segments(std::size_t node_co
   return chains;
 }
 
-ThinWallModel2D::ThinWallModel2D(const ImmersedSurfaceGeometry<2>& g, const FluidSettings<2>& fluid, ThinWallSettings settings)
+ThinWallModel2D::ThinWallModel2D(const ImmersedSurfaceGeometry<2>& g, const FluidSettings<2>& fluid, ThinWallSettings settings,
+                                 double coaptation_distance)
     : node_count_(g.nodes.size()),
       chains_((g.nodes_per_cell == 2
                    ? chains_from_segments(g.nodes.size(), g.cells)
                    : throw std::invalid_argument(fmt::format("{}: nodes_per_cell = {}: allowed 2 (segments) in 2D", kSource,
                                                              g.nodes_per_cell)))),
       thickness_(g.node_thickness),
+      fluid_(fluid),
+      settings_(settings),
+      coaptation_distance_(coaptation_distance),
       motion_(std::vector<Vec2>(g.nodes.begin(), g.nodes.end()), 0.0) {
   if (thickness_.size() != node_count_)
     throw std::invalid_argument(
@@ -97,7 +102,55 @@ ThinWallModel2D::ThinWallModel2D(const ImmersedSurfaceGeometry<2>& g, const Flui
     own.clearance_ratio = std::max(settings.clearance_ratio, 0.5 * thickest / fluid.particle_spacing);
     walls_.emplace_back(Polyline::at_rest(std::move(nodes)), fluid, own);
   }
+  if (!(coaptation_distance >= 0.0) || !std::isfinite(coaptation_distance))
+    throw std::invalid_argument(fmt::format("thin wall: coaptation distance {} m: allowed >= 0", coaptation_distance));
+  // Every pair of end nodes of different chains may be bridged; each chain's ends come in
+  // chain order, so a bridge always runs from an earlier chain's end to a later one's.
+  if (coaptation_distance > 0.0)
+    for (std::size_t c1 = 0; c1 < chains_.size(); ++c1)
+      for (std::size_t c2 = c1 + 1; c2 < chains_.size(); ++c2)
+        for (const std::uint32_t a : {chains_[c1].front(), chains_[c1].back()})
+          for (const std::uint32_t b : {chains_[c2].front(), chains_[c2].back()}) bridges_.push_back({a, b, std::nullopt, {}});
   move_to(0.0);
+}
+
+TwoSidedWall ThinWallModel2D::make_bridge_wall(const std::vector<Vec2>& ends, std::uint32_t a, std::uint32_t b) const {
+  // Put-back and shifted particles keep half the thicker end's thickness from the bridge too.
+  ThinWallSettings own = settings_;
+  own.clearance_ratio = std::max(settings_.clearance_ratio, 0.5 * std::max(thickness_[a], thickness_[b]) / fluid_.particle_spacing);
+  return TwoSidedWall(Polyline::at_rest(ends), fluid_, own);
+}
+
+void ThinWallModel2D::update_bridges() {
+  // Below this length the bridge has no direction (and the ends block pairs by touching).
+  const double shortest = 1e-3 * fluid_.particle_spacing;
+  for (std::size_t k = 0; k < bridges_.size(); ++k) {
+    CoaptationBridge& b = bridges_[k];
+    const Vec2 xa = x_[b.node_a], xb = x_[b.node_b];
+    const double d = std::hypot(xb[0] - xa[0], xb[1] - xa[1]);
+    const bool engage = !b.wall && d < coaptation_distance_ && d > shortest;
+    const bool release = b.wall && (d > kCoaptationReleaseFactor * coaptation_distance_ || d <= shortest);
+    if (engage) {
+      b.reference = {xa, xb};
+      b.wall.emplace(make_bridge_wall(b.reference, b.node_a, b.node_b));
+      Polyline& w = b.wall->wall();
+      w.velocity = {v_[b.node_a], v_[b.node_b]};
+      w.acceleration = {a_[b.node_a], a_[b.node_b]};
+      ++engagements_;
+    } else if (release) {
+      const WallCounters& c = b.wall->counters();
+      released_.corrections += c.corrections;
+      released_.leaks += c.leaks;
+      released_.rejected_shifts += c.rejected_shifts;
+      b.wall.reset();
+    }
+    // The first events and then every hundredth: a bridge that chatters says so without
+    // flooding the log.
+    const std::size_t events = 2 * engagements_ - (b.wall ? 1 : 0);
+    if ((engage || release) && (events <= 20 || events % 100 == 0))
+      spdlog::info("thin wall: t = {:.5f} s: free ends {} and {} {:.3f} mm apart: coaptation bridge {} (event {})",
+                   motion_.current_time(), b.node_a, b.node_b, 1e3 * d, engage ? "engaged" : "released", events);
+  }
 }
 
 void ThinWallModel2D::set_window_target(double end_time, std::span<const Vec<2>> end_positions,
@@ -116,6 +169,13 @@ void ThinWallModel2D::move_to(double time) {
       w.acceleration[k] = a_[chain[k]];
     }
   }
+  for (auto& b : bridges_) {
+    if (!b.wall) continue;
+    Polyline& w = b.wall->wall();
+    w.position = {x_[b.node_a], x_[b.node_b]};
+    w.velocity = {v_[b.node_a], v_[b.node_b]};
+    w.acceleration = {a_[b.node_a], a_[b.node_b]};
+  }
 }
 
 double ThinWallModel2D::max_node_speed() const {
@@ -125,42 +185,37 @@ double ThinWallModel2D::max_node_speed() const {
 }
 
 void ThinWallModel2D::begin_step(const Particles<2>& particles) {
-  for (auto& w : walls_) w.begin_step(particles);
+  update_bridges();
+  all_walls([&](TwoSidedWall& w) { return w.begin_step(particles), true; });
 }
 
 void ThinWallModel2D::correct_crossings(Particles<2>& particles) {
-  for (auto& w : walls_) w.correct_crossings(particles);
+  all_walls([&](TwoSidedWall& w) { return w.correct_crossings(particles), true; });
 }
 
 void ThinWallModel2D::classify(const Particles<2>& particles) {
-  for (auto& w : walls_) w.classify(particles);
+  all_walls([&](TwoSidedWall& w) { return w.classify(particles), true; });
 }
 
 bool ThinWallModel2D::near_surface(std::size_t i) const {
-  for (const auto& w : walls_)
-    if (w.near_wall(i).near) return true;
-  return false;
+  return !all_walls([&](const TwoSidedWall& w) { return !w.near_wall(i).near; });
 }
 
 bool ThinWallModel2D::blocked(std::uint32_t a, std::uint32_t b, const Particles<2>& particles) const {
-  for (const auto& w : walls_)
-    if (w.blocked(a, b, particles)) return true;
-  return false;
+  return !all_walls([&](const TwoSidedWall& w) { return !w.blocked(a, b, particles); });
 }
 
 void ThinWallModel2D::update_surface_states(const Particles<2>& particles, const CellGrid<2>& grid) {
-  for (auto& w : walls_) w.update_marker_states(particles, grid);
+  all_walls([&](TwoSidedWall& w) { return w.update_marker_states(particles, grid), true; });
 }
 
 void ThinWallModel2D::add_surface_rates(Particles<2>& particles) {
-  for (auto& w : walls_) w.add_wall_rates(particles);
+  all_walls([&](TwoSidedWall& w) { return w.add_wall_rates(particles), true; });
 }
 
 bool ThinWallModel2D::accept_shift(const Particles<2>& particles, std::size_t i, const Vec<2>& shift) {
   // Stops at the first wall that refuses, so a refusal is counted once.
-  for (auto& w : walls_)
-    if (!w.accept_shift(particles, i, shift)) return false;
-  return true;
+  return all_walls([&](TwoSidedWall& w) { return w.accept_shift(particles, i, shift); });
 }
 
 void ThinWallModel2D::node_forces(std::span<Vec<2>> forces) const {
@@ -173,24 +228,38 @@ void ThinWallModel2D::node_forces(std::span<Vec<2>> forces) const {
     for (std::size_t k = 0; k < chain.size(); ++k)
       for (int d = 0; d < 2; ++d) forces[chain[k]][d] += f[k][d];
   }
+  for (const auto& b : bridges_) {
+    if (!b.wall) continue;
+    const auto f = b.wall->markers().node_forces(2);
+    for (int d = 0; d < 2; ++d) {
+      forces[b.node_a][d] += f[0][d];
+      forces[b.node_b][d] += f[1][d];
+    }
+  }
 }
 
 ImmersedSurfaceCounters ThinWallModel2D::counters() const {
-  ImmersedSurfaceCounters total;
-  for (const auto& w : walls_) {
+  ImmersedSurfaceCounters total{released_.corrections, released_.leaks, released_.rejected_shifts};
+  all_walls([&](const TwoSidedWall& w) {
     total.corrections += w.counters().corrections;
     total.leaks += w.counters().leaks;
     total.rejected_shifts += w.counters().rejected_shifts;
-  }
+    return true;
+  });
   return total;
 }
 
-void ThinWallModel2D::save_checkpoint() { checkpoint_ = std::make_unique<Checkpoint>(Checkpoint{motion_, walls_}); }
+void ThinWallModel2D::save_checkpoint() {
+  checkpoint_ = std::make_unique<Checkpoint>(Checkpoint{motion_, walls_, bridges_, released_, engagements_});
+}
 
 void ThinWallModel2D::restore_checkpoint() {
   if (!checkpoint_) throw std::logic_error("thin wall restore_checkpoint: no checkpoint was saved");
   motion_ = checkpoint_->motion;
   walls_ = checkpoint_->walls;
+  bridges_ = checkpoint_->bridges;
+  released_ = checkpoint_->released;
+  engagements_ = checkpoint_->engagements;
   move_to(motion_.current_time());
 }
 
@@ -198,6 +267,19 @@ std::optional<std::vector<NamedArray>> ThinWallModel2D::restart_state() const {
   RestartWriter out;
   motion_.save(out, "motion");
   for (std::size_t c = 0; c < walls_.size(); ++c) walls_[c].save_state(out, fmt::format("wall{}", c));
+  if (!bridges_.empty()) {
+    std::vector<double> engaged;
+    for (const auto& b : bridges_) engaged.push_back(b.wall ? 1.0 : 0.0);
+    out.scalars("bridges.engaged", engaged);
+    out.scalars("bridges.released", std::vector<double>{static_cast<double>(released_.corrections), static_cast<double>(released_.leaks),
+                                                        static_cast<double>(released_.rejected_shifts),
+                                                        static_cast<double>(engagements_)});
+    for (std::size_t k = 0; k < bridges_.size(); ++k) {
+      if (!bridges_[k].wall) continue;
+      out.vectors(fmt::format("bridge{}.reference", k), bridges_[k].reference);
+      bridges_[k].wall->save_state(out, fmt::format("bridge{}", k));
+    }
+  }
   return out.take();
 }
 
@@ -208,8 +290,33 @@ void ThinWallModel2D::load_restart_state(std::span<const NamedArray> arrays) {
   motion.load(in, "motion");
   std::vector<TwoSidedWall> walls = walls_;
   for (std::size_t c = 0; c < walls.size(); ++c) walls[c].load_state(in, fmt::format("wall{}", c));
+  std::vector<CoaptationBridge> bridges = bridges_;
+  WallCounters released;
+  std::size_t engagements = 0;
+  if (!bridges.empty() && !in.has("bridges.engaged")) {
+    spdlog::warn("thin wall: the restart state has no coaptation bridges (written without them): they start released and "
+                 "engage at the first step where two free ends are within {:.3f} mm",
+                 1e3 * coaptation_distance_);
+    for (auto& b : bridges) b.wall.reset();
+  } else if (!bridges.empty()) {
+    const auto engaged = in.scalars<double>("bridges.engaged", bridges.size());
+    const auto counts = in.scalars<std::size_t>("bridges.released", 4);
+    released = {counts[0], counts[1], counts[2]};
+    engagements = counts[3];
+    for (std::size_t k = 0; k < bridges.size(); ++k) {
+      CoaptationBridge& b = bridges[k];
+      b.wall.reset();
+      if (engaged[k] == 0.0) continue;
+      b.reference = in.vectors<2>(fmt::format("bridge{}.reference", k), 2);
+      b.wall.emplace(make_bridge_wall(b.reference, b.node_a, b.node_b));
+      b.wall->load_state(in, fmt::format("bridge{}", k));
+    }
+  }
   motion_ = std::move(motion);
   walls_ = std::move(walls);
+  bridges_ = std::move(bridges);
+  released_ = released;
+  engagements_ = engagements;
   motion_.evaluate(motion_.current_time(), x_, v_, a_);
 }
 
@@ -222,7 +329,7 @@ std::unique_ptr<ImmersedSurfaceModel<2>> make_thin_wall_model_2d(const ImmersedS
   settings.virtual_spacing_ratio = checked.virtual_spacing_ratio();
   settings.clearance_ratio = checked.clearance_ratio();
   settings.wall_acceleration_in_pressure = checked.wall_acceleration_in_pressure();
-  return std::make_unique<ThinWallModel2D>(geometry, fluid, settings);
+  return std::make_unique<ThinWallModel2D>(geometry, fluid, settings, checked.coaptation_distance());
 }
 
 }  // namespace valvefsi::fluid::thin_wall

@@ -1205,6 +1205,12 @@ std::unique_ptr<ImmersedSurfaceModel<3>> make_thin_wall_model_3d(const ImmersedS
   valvefsi::cases::FluidThinWalls checked = walls;
   const bool spacing_given = walls.has_virtual_spacing_ratio();
   apply_field_limits(checked, "fluid case", "fluid.thin_walls");
+  // The 3D sector closes onto its coaptation plane and the full valve's free edges meet along
+  // lines: the 2D bridge between two end points does not carry over.
+  if (checked.coaptation_distance() > 0.0)
+    throw valvefsi::CaseError(fmt::format("fluid case: fluid.thin_walls.coaptation_distance = {} m: allowed only 0 in 3D (the "
+                                          "coaptation bridge joins the free ends of a 2D section)",
+                                          checked.coaptation_distance()));
   ThinWall3DSettings settings;
   if (spacing_given) settings.virtual_spacing_ratio = checked.virtual_spacing_ratio();
   settings.clearance_ratio = checked.clearance_ratio();

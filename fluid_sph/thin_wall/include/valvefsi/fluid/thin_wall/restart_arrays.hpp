@@ -69,6 +69,11 @@ class RestartReader {
       }
     throw std::runtime_error(fmt::format("{}: array '{}' is missing", owner_, name));
   }
+  bool has(const std::string& name) const {
+    for (const auto& a : arrays_)
+      if (a.name == name) return true;
+    return false;
+  }
   template <class T>
   std::vector<T> scalars(const std::string& name, std::size_t entries = 0) const {
     const auto& v = find(name, 1, entries);

@@ -14,6 +14,7 @@ namespace valvefsi::fluid::thin_wall {
 struct ThinWallCase2D {
   FluidSettings<2> fluid;
   ThinWallSettings wall_settings;
+  double coaptation_distance = 0.0;  // m; ThinWallModel2D's bridge between free ends (0: off)
   SceneGeometry<2> scene;      // rigid tank walls and fluid blocks (fill_particles)
   std::vector<Polyline> walls;  // the thin walls (leaflets) at t = 0
   // Prescribed motion: sets every wall's node positions and velocities at a time (the
@@ -26,6 +27,12 @@ struct ThinWallCase2D {
 // gap = 0: the wall is buried 3 dp into the floor (attachment line); gap > 0: its lower free
 // end stands `gap` above the floor. The wall's nodes run upwards, so side +1 is the left.
 ThinWallCase2D two_level_tank(double dp, double left_level, double right_level, double gap);
+
+// The same tank with the dividing wall in two pieces that nearly meet: a lower one from the
+// floor (buried 3 dp) to y = joint - gap / 2 and an upper one from y = joint + gap / 2 to
+// 1.2 m, both running upwards. Their facing ends are free ends `gap` apart (a closed 2D
+// valve's tips); set the case's coaptation_distance above gap to join them for the fluid.
+ThinWallCase2D two_level_tank_with_joint(double dp, double left_level, double right_level, double joint, double gap);
 
 // A closed box [-L/2, L/2] x [-H/2, H/2] full of water (no gravity) with a plate of width b
 // along y at x = X(t) = -A cos(omega t), oscillating normal to itself (from rest).

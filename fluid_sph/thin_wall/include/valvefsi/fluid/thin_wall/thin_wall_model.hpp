@@ -4,6 +4,14 @@
 // TwoSidedWall per chain of segments; the model moves them through each coupling window
 // (cubic Hermite between the window's start state and the coupler's target), and returns the
 // fluid's force on the coupler's nodes (N per metre of depth). docs/thin-leaflet.md.
+//
+// Coaptation (optional): where two free ends of different leaflets come within the
+// coaptation distance, the fluid sees them joined by a bridge, a two-sided wall from one end to
+// the other, until they part by more than kCoaptationReleaseFactor times that distance. A 2D
+// section cannot close its leaflets onto each other (the shells' contact keeps their
+// mid-lines a thickness apart, and the section stands for a 3D line where the leaflets meet
+// over millimetres), so without the bridge the closed valve leaks through the tips' gap as
+// an orifice (docs/fsi-2d.md, "Session 20"). The bridge's load goes to its two end nodes.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -27,11 +35,24 @@ std::vector<std::vector<std::uint32_t>> chains_from_segments(std::size_t node_co
 
 using WindowMotion = WindowMotionT<2>;
 
+// A bridge engaged below the coaptation distance is released above this multiple of it, so a
+// pair of ends resting near the threshold does not engage and release every step.
+inline constexpr double kCoaptationReleaseFactor = 1.25;
+
+// Two free ends that may be bridged, and the bridge while it is engaged.
+struct CoaptationBridge {
+  std::uint32_t node_a = 0, node_b = 0;  // the coupler's node indices (end of an earlier chain first)
+  std::optional<TwoSidedWall> wall;      // engaged: the wall from node_a to node_b
+  std::vector<Vec2> reference;           // the two ends when it engaged (its markers' layout)
+};
+
 // ImmersedSurfaceModel<2> over one TwoSidedWall per chain. Node indices in the interface are
 // those of the coupler's geometry.
 class ThinWallModel2D final : public ImmersedSurfaceModel<2> {
  public:
-  ThinWallModel2D(const ImmersedSurfaceGeometry<2>& geometry, const FluidSettings<2>& fluid, ThinWallSettings settings);
+  // coaptation_distance (m): 0 leaves free ends unbridged.
+  ThinWallModel2D(const ImmersedSurfaceGeometry<2>& geometry, const FluidSettings<2>& fluid, ThinWallSettings settings,
+                  double coaptation_distance = 0.0);
 
   void set_window_target(double end_time, std::span<const Vec<2>> end_positions,
                          std::span<const Vec<2>> end_velocities) override;
@@ -56,7 +77,9 @@ class ThinWallModel2D final : public ImmersedSurfaceModel<2> {
 
   // Restart files: the window's motion ("motion.*") and every chain's state ("wall<k>.*":
   // nodes, markers, counters, per-particle data in the particle order of the moment, side
-  // memory by particle id).
+  // memory by particle id); with coaptation, which bridges are engaged ("bridges.engaged"),
+  // the released bridges' counters and each engaged bridge ("bridge<k>.*"). A restart written
+  // without coaptation loads into a model with it: the bridges start released (logged).
   std::optional<std::vector<NamedArray>> restart_state() const override;
   void load_restart_state(std::span<const NamedArray> arrays) override;
 
@@ -65,17 +88,51 @@ class ThinWallModel2D final : public ImmersedSurfaceModel<2> {
   const std::vector<TwoSidedWall>& walls() const { return walls_; }
   const std::vector<double>& node_thickness() const { return thickness_; }
   double time() const { return motion_.current_time(); }
+  const std::vector<CoaptationBridge>& bridges() const { return bridges_; }
+  double coaptation_distance() const { return coaptation_distance_; }
+  std::size_t bridge_engagements() const { return engagements_; }
 
  private:
   struct Checkpoint {
     WindowMotion motion;
     std::vector<TwoSidedWall> walls;
+    std::vector<CoaptationBridge> bridges;
+    WallCounters released;
+    std::size_t engagements = 0;
   };
+
+  // Engages or releases each bridge from the distance between its ends now.
+  void update_bridges();
+  // Calls f on every chain's wall and every engaged bridge; stops when f returns false and
+  // returns whether all returned true.
+  template <class F>
+  bool all_walls(F&& f) {
+    for (auto& w : walls_)
+      if (!f(w)) return false;
+    for (auto& b : bridges_)
+      if (b.wall && !f(*b.wall)) return false;
+    return true;
+  }
+  template <class F>
+  bool all_walls(F&& f) const {
+    for (const auto& w : walls_)
+      if (!f(w)) return false;
+    for (const auto& b : bridges_)
+      if (b.wall && !f(*b.wall)) return false;
+    return true;
+  }
+  TwoSidedWall make_bridge_wall(const std::vector<Vec2>& ends, std::uint32_t a, std::uint32_t b) const;
 
   std::size_t node_count_ = 0;
   std::vector<std::vector<std::uint32_t>> chains_;  // node indices of each wall, in order
   std::vector<double> thickness_;
   std::vector<TwoSidedWall> walls_;
+  FluidSettings<2> fluid_;
+  ThinWallSettings settings_;
+  double coaptation_distance_ = 0.0;
+  std::vector<CoaptationBridge> bridges_;
+  WallCounters released_;  // counters of bridges since released
+  std::size_t engagements_ = 0;
   WindowMotion motion_;
   std::vector<Vec2> x_, v_, a_;  // scratch: all nodes at the last move_to
   std::unique_ptr<Checkpoint> checkpoint_;

@@ -160,6 +160,15 @@ class Geometry(unittest.TestCase):
         self.assertAlmostEqual(gap, P.coaptation_gap, delta=1e-12)   # 0.5 mm, as in 3D
         self.assertLess(gap, 1e-3)
 
+    def test_coaptation_bridge_joins_the_resting_tips(self):
+        # the fluid joins tips closer than the coaptation distance (released at 1.25x): the
+        # stress-free tips (the mesh gap) must be joined; released within two of the finest spacing
+        self.assertGreater(valve2d.COAPTATION_DISTANCE_2D, P.coaptation_gap)
+        self.assertLess(valve2d.COAPTATION_DISTANCE_2D * 1.25, min(valve2d.PARTICLE_SPACING_2D.values()) * 2)
+        for spec in all_specs_2d():
+            if spec.kind == "FSI":
+                self.assertIn(f"coaptation_distance: {valve2d.COAPTATION_DISTANCE_2D:g} }}", case_text_2d(spec))
+
     def test_channel_parameters_are_checked(self):
         with self.assertRaisesRegex(ValueError, "'upstream_tap_distance' = 0.2"):
             Channel2D(upstream_tap_distance=0.2).validate()

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "valvefsi/fluid/case_setup.hpp"
+#include "valvefsi/fluid/mirror_group.hpp"
 #include "valvefsi/fluid/output.hpp"
 
 namespace valvefsi::fluid::app {
@@ -58,7 +59,12 @@ class RunOutput {
   // total force on the interface (ignored without interface columns).
   void write_due(const FluidSolver<D>& solver, const Vec<D>& interface_force = {}) {
     const double t = solver.time();
-    if (std::isnan(first_time_)) first_time_ = t;  // a restarted run's rate counts from its restart time
+    if (std::isnan(first_time_)) {
+      first_time_ = t;  // a restarted run's rate counts from its restart time
+      // Copies of this fluid that make the whole (6 for a 1/6 sector): the analysis scales a
+      // part's flows and forces with it (scripts/valve_scene/hemodynamics.py).
+      series_.set_attribute("symmetry_factor", mirror_symmetry_factor(solver.settings().mirror_planes));
+    }
     if (snapshot_interval_ > 0 && t >= next_snapshot_ * (1 - 1e-12)) {
       snapshots_.write(solver);
       while (next_snapshot_ <= t * (1 + 1e-12)) next_snapshot_ += snapshot_interval_;

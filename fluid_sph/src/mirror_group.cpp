@@ -112,6 +112,20 @@ std::vector<MirrorMap<D>> compound_mirror_maps(const std::vector<MirrorPlane<D>>
   return compound;
 }
 
+template <int D>
+double mirror_symmetry_factor(const std::vector<MirrorPlane<D>>& planes) {
+  for (std::size_t a = 0; a < planes.size(); ++a)
+    for (std::size_t b = a + 1; b < planes.size(); ++b) {
+      double cosine = 0;
+      for (int d = 0; d < D; ++d) cosine += planes[a].normal[d] * planes[b].normal[d];
+      if (std::abs(cosine) >= 1.0 - 1e-12) return 0.0;
+    }
+  // The identity, each plane's reflection and the compound images.
+  return static_cast<double>(1 + planes.size() + compound_mirror_maps<D>(planes).size());
+}
+
+template double mirror_symmetry_factor<2>(const std::vector<MirrorPlane<2>>&);
+template double mirror_symmetry_factor<3>(const std::vector<MirrorPlane<3>>&);
 template std::vector<MirrorMap<2>> compound_mirror_maps<2>(const std::vector<MirrorPlane<2>>&, std::size_t);
 template std::vector<MirrorMap<3>> compound_mirror_maps<3>(const std::vector<MirrorPlane<3>>&, std::size_t);
 

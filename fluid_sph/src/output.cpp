@@ -153,12 +153,28 @@ void SeriesWriter::append(double time, const std::vector<double>& values) {
     for (int j = 0; j < c.components; ++j) c.data.push_back(values[k++]);
 }
 
+void SeriesWriter::set_attribute(const std::string& name, double value) {
+  for (auto& a : attributes_)
+    if (a.first == name) {
+      a.second = value;
+      return;
+    }
+  attributes_.emplace_back(name, value);
+}
+
 void SeriesWriter::flush() const {
   std::filesystem::create_directories(file_.parent_path().empty() ? "." : file_.parent_path());
   const hid_t h = check_id(H5Fcreate(file_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), "create " + file_.string());
   write_dataset(h, "time", time_.data(), time_.size(), 1, H5T_NATIVE_DOUBLE);
   for (const auto& c : columns_)
     write_dataset(h, c.path, c.data.data(), time_.size(), static_cast<hsize_t>(c.components), H5T_NATIVE_DOUBLE);
+  for (const auto& [name, value] : attributes_) {
+    const hid_t scalar = H5Screate(H5S_SCALAR);
+    const hid_t attribute = H5Acreate2(h, name.c_str(), H5T_NATIVE_DOUBLE, scalar, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(attribute, H5T_NATIVE_DOUBLE, &value);
+    H5Aclose(attribute);
+    H5Sclose(scalar);
+  }
   H5Fclose(h);
 }
 

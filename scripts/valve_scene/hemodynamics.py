@@ -105,6 +105,10 @@ class ProbeSeries:
     particle_spacing: float | None = None   # m: its particles' spacing (volume dp^3 each), or None
     tip_gap_time: np.ndarray | None = None  # 2D: solid sample times (s) of tip_gap, or None
     tip_gap: np.ndarray | None = None       # 2D: distance between the two leaflets' tips (m), or None
+    symmetry_factor: float | None = None    # copies of the fluid that make the whole (6 for a 1/6 sector;
+                                            # fluid_probes.h5's attribute; 0: no finite whole), or None
+                                            # for a run written before the fluid recorded it
+    source: Path | None = None              # the probe file read
 
     @property
     def mean_flow_rate(self) -> np.ndarray:
@@ -245,7 +249,9 @@ def read_run(run_dir: Path, upstream: str = "upstream_tap", downstream: str = "d
                              jet_core_flow=(f["flow_rate"][JET_CORE_PLANE][()].reshape(-1)
                                             if JET_CORE_PLANE in f["flow_rate"] else None),
                              upstream_centre=f["pressure"][upstream][()].reshape(-1),
-                             downstream_centre=f["pressure"][downstream][()].reshape(-1))
+                             downstream_centre=f["pressure"][downstream][()].reshape(-1),
+                             symmetry_factor=(float(f.attrs["symmetry_factor"]) if "symmetry_factor" in f.attrs else None),
+                             source=path)
     coupling = run_dir / "coupling_series.h5"
     if coupling.exists():
         with h5py.File(coupling, "r") as f:
@@ -674,15 +680,31 @@ def annulus_area(dimension: int, radius: float = ANNULUS_RADIUS_M) -> float:
     return math.pi * radius ** 2 if dimension == 3 else 2.0 * radius
 
 
+def whole_valve_factor(series: ProbeSeries, requested: float | None = None) -> float:
+    """The factor from the series' flows and forces to the whole valve's: the fluid's record,
+    or `requested` where the run has none. Refuses a request that contradicts the record, and a
+    fluid with no finite whole (parallel mirror planes), whose flows no factor makes a valve's."""
+    recorded = series.symmetry_factor
+    where = series.source or "the probe series"
+    if recorded is not None and recorded <= 0:
+        raise ValueError(f"{where}: symmetry_factor = {recorded:g}: the fluid's mirror planes are parallel, "
+                         "no number of copies makes a whole valve")
+    if recorded is not None and requested is not None and abs(requested - recorded) > 1e-9 * recorded:
+        raise ValueError(f"{where}: symmetry factor {requested:g} requested, but the fluid recorded {recorded:g} "
+                         f"(its mirror planes make {recorded:g} copies of it the whole): leave the option out")
+    return float(recorded if recorded is not None else (requested if requested is not None else 1.0))
+
+
 def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.PERIOD_S,
                   smoothing_s: float = 0.002, closure_time_s: float | None = None,
                   hydrostatic_Pa: float | None = None, annulus_radius: float = ANNULUS_RADIUS_M,
-                  symmetry_factor: float = 1.0, allow_partial: bool = False,
+                  symmetry_factor: float | None = None, allow_partial: bool = False,
                   particle_spacing: float | None = None) -> CycleHemodynamics:
     """Metrics of cycle `cycle` (1-based: [(cycle-1) T, cycle T)). closure_time_s, if given, is
     the valve's closure within the cycle (e.g. from the kinematics) and splits closing from
     leakage volume. symmetry_factor multiplies the flows and forces of a symmetric part (6 for
-    the 1/6 sector) into the whole valve's. allow_partial accepts a series that ends before the
+    the 1/6 sector) into the whole valve's: by default the one the fluid recorded (1 for a run
+    written before it did); a given one that contradicts the record is refused. allow_partial accepts a series that ends before the
     cycle does, once the forward flow has ended in it (a run that covers only the parts of the
     cycle the metrics need): the result's series_end_s says where the diastolic quantities stop,
     and its regurgitant volume is closing + the leak rate x (cycle end - closure) when the leak
@@ -690,6 +712,7 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
     Where the series has particle snapshots (read_run) the leak through the valve by particle
     count (valve_leak; particle_spacing overrides the log's) is the leak rate the leakage from
     the rate uses; else the flow sections' fit (leak_rate)."""
+    symmetry_factor = whole_valve_factor(series, symmetry_factor)
     start, end = (cycle - 1) * period, cycle * period
     t_all = series.time
     sel = (t_all >= start - 1e-12) & (t_all <= end + 1e-12)
@@ -958,8 +981,9 @@ def main(argv=None) -> None:
     parser.add_argument("--model", default="this run", help="column name in the table, e.g. FSI-Ogden")
     parser.add_argument("--closure-time", type=float, help="valve closure within the cycle (s), e.g. from the kinematics")
     parser.add_argument("--sections", nargs="+", help="flow sections to average (default: all in the file)")
-    parser.add_argument("--symmetry-factor", type=float, default=1.0,
-                        help="flows and forces x this for the whole valve (6 for a 1/6-sector run)")
+    parser.add_argument("--symmetry-factor", type=float,
+                        help="flows and forces x this for the whole valve (6 for a 1/6-sector run); "
+                             "default: what the fluid recorded in fluid_probes.h5, else 1")
     parser.add_argument("--markdown", type=Path, help="write the table here")
     parser.add_argument("--png", type=Path, help="write the Fig. 11-like plot here")
     parser.add_argument("--partial", action="store_true",

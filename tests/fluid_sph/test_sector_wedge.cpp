@@ -159,5 +159,22 @@ TEST(MirrorGroup, SixtyDegreePlanesCloseInSixElements) {
   EXPECT_NE(infinite.find("more than 48"), std::string::npos) << infinite;
 }
 
+TEST(MirrorGroup, SymmetryFactorCountsTheCopiesOfTheWhole) {
+  // The factor from a part's flows to the whole's: the group's order.
+  EXPECT_EQ(mirror_symmetry_factor<3>({}), 1.0);
+  EXPECT_EQ(mirror_symmetry_factor<3>({{{0, 0, 0}, {0, 1, 0}}}), 2.0);
+  std::vector<MirrorPlane<3>> sixty = {{{0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}},
+                                       {{0.0, 0.0, 0.0}, {std::sin(kSixty), -std::cos(kSixty), 0.0}}};
+  EXPECT_EQ(mirror_symmetry_factor<3>(sixty), 6.0);
+  std::vector<MirrorPlane<3>> octant = {{{0, 0, 0}, {1, 0, 0}}, {{0, 0, 0}, {0, 1, 0}}, {{0, 0, 0}, {0, 0, 1}}};
+  EXPECT_EQ(mirror_symmetry_factor<3>(octant), 8.0);
+  // A 30-degree wedge: 12 copies.
+  const double thirty = 30.0 * std::numbers::pi / 180.0;
+  EXPECT_EQ(mirror_symmetry_factor<3>({{{0, 0, 0}, {0, 1, 0}}, {{0, 0, 0}, {std::sin(thirty), -std::cos(thirty), 0}}}), 12.0);
+  // Between parallel mirror walls there is no finite whole.
+  EXPECT_EQ(mirror_symmetry_factor<3>({{{0, 0, 0}, {0, 1, 0}}, {{0, 1, 0}, {0, -1, 0}}}), 0.0);
+  EXPECT_EQ(mirror_symmetry_factor<2>({{{0, 0}, {1, 0}}, {{0, 0}, {0, 1}}}), 4.0);
+}
+
 }  // namespace
 }  // namespace valvefsi::fluid

@@ -267,6 +267,31 @@ class Files(unittest.TestCase):
             self.assertAlmostEqual(a.eoa, b.eoa, delta=1e-12)
             self.assertAlmostEqual(a.diastolic_force, b.diastolic_force, delta=1e-12)
 
+    def test_the_fluids_recorded_symmetry_factor_scales_a_sector(self):
+        full = synthetic()
+        sector = synthetic()
+        sector.flow_rates = {k: v / 6 for k, v in sector.flow_rates.items()}
+        sector.axial_force = sector.axial_force / 6
+        expected = hd.analyse_cycle(full, smoothing_s=0.0)
+        with tempfile.TemporaryDirectory() as tmp:
+            folder = Path(tmp)
+            self.write_run(folder, sector)
+            self.assertIsNone(hd.read_run(folder).symmetry_factor)   # written before the fluid recorded it
+            with h5py.File(folder / "fluid_probes.h5", "a") as f:
+                f.attrs["symmetry_factor"] = 6.0
+            read = hd.read_run(folder)
+            self.assertEqual(read.symmetry_factor, 6.0)
+            r = hd.analyse_cycle(read, smoothing_s=0.0)
+            self.assertAlmostEqual(r.eoa, expected.eoa, delta=1e-9 * expected.eoa)
+            self.assertAlmostEqual(r.diastolic_force, expected.diastolic_force, delta=1e-9 * abs(expected.diastolic_force))
+            self.assertEqual(hd.analyse_cycle(read, smoothing_s=0.0, symmetry_factor=6).eoa, r.eoa)
+            with self.assertRaisesRegex(ValueError, "fluid_probes.h5: symmetry factor 1 requested, but the fluid recorded 6"):
+                hd.analyse_cycle(read, smoothing_s=0.0, symmetry_factor=1)
+            with h5py.File(folder / "fluid_probes.h5", "a") as f:
+                f.attrs["symmetry_factor"] = 0.0
+            with self.assertRaisesRegex(ValueError, "mirror planes are parallel"):
+                hd.analyse_cycle(hd.read_run(folder), smoothing_s=0.0)
+
     def test_2d_run_reads_the_tips_gap_from_the_solid_series(self):
         series = synthetic(dimension=2)
         with tempfile.TemporaryDirectory() as tmp:

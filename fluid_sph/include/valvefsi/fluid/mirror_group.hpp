@@ -42,4 +42,11 @@ struct MirrorMap {
 template <int D>
 std::vector<MirrorMap<D>> compound_mirror_maps(const std::vector<MirrorPlane<D>>& planes, std::size_t max_order = 48);
 
+// How many copies of the fluid the planes' reflections make of the whole (the order of the group
+// they generate: 1 without planes, 2 for one plane, 6 for a 60-degree sector): the factor from a
+// part's flows and forces to the whole's. 0 when there is no finite whole (parallel planes: a
+// strip between mirror walls). Throws as compound_mirror_maps does for planes that never close.
+template <int D>
+double mirror_symmetry_factor(const std::vector<MirrorPlane<D>>& planes);
+
 }  // namespace valvefsi::fluid

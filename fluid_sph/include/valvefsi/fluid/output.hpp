@@ -3,6 +3,7 @@
 // (fluid_particles.xmf), and probe time series in HDF5 (fluid_probes.h5).
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "valvefsi/fluid/fluid_solver.hpp"
@@ -40,6 +41,8 @@ class SeriesWriter {
   // Columns must all be declared before the first append.
   void add_column(const std::string& path, int components = 1);
   void append(double time, const std::vector<double>& values);  // all columns' components, in order
+  // A number about the whole series, written as an attribute of the file's root.
+  void set_attribute(const std::string& name, double value);
   void flush() const;
   std::size_t samples() const { return time_.size(); }
 
@@ -52,6 +55,7 @@ class SeriesWriter {
   std::filesystem::path file_;
   std::vector<double> time_;
   std::vector<Column> columns_;
+  std::vector<std::pair<std::string, double>> attributes_;
 };
 
 }  // namespace valvefsi::fluid

@@ -63,10 +63,9 @@ class CaseFiles(unittest.TestCase):
                 self.assertAlmostEqual(step / window, 0.5, delta=1e-9)
                 self.assertEqual(first, step)
                 self.assertIn("  spectral_radius_infinity: 0.5\n", solid)
-                # the scheme's own ledger bias reached 0.35 of the largest energy at 198 ms (docs/fsi-3d.md)
-                self.assertIn("  max_energy_balance_error: 1\n", solid)
-            else:
-                self.assertNotIn("max_energy_balance_error", solid)
+            # every case keeps the energy check's default 0.2: the sector cycles read 0.000 from
+            # t = 0 into diastole (docs/fsi-3d.md, session 22)
+            self.assertNotIn("max_energy_balance_error", solid)
 
     def test_fe_only_cases_damp_the_closed_valve_from_its_onset_and_fsi_cases_do_not(self):
         for spec in all_specs():

@@ -3,7 +3,7 @@
 
     /usr/bin/python3 scripts/run_case.py CASE [--output DIR] [--fluid-ranks N] [--fe-only]
         [--fluid-exe PATH] [--solid-exe PATH] [--coupler-exe PATH] [--build-dir DIR] [--grace S]
-        [--restart RUN/restart]
+        [--restart RUN/restart] [--resume]
 
 Each program is started as `<executable> <case arguments...> --case CASE --output DIR` (the
 solid also gets `--fe-only` with --fe-only), with VALVEFSI_COUPLER_ENDPOINT set so that all
@@ -17,6 +17,13 @@ are stopped), then SIGKILL after the grace period; the launcher exits with the f
 program's code (128 + signal for a signal). SIGINT/SIGTERM to the launcher stop them all.
 The case is read by the coupler's own loader (`coupler --describe-launch`), so a bad case is
 reported exactly as the programs would report it.
+
+--resume makes a run of hours one command however often it is interrupted: into an empty or new
+DIR the run goes as usual; into a DIR that holds a run, the run continues from the newest restart
+point as a new segment, DIR/segments/NN (the first time, what DIR held becomes DIR/segments/01),
+and when it ends (finished, failed or stopped) all segments are joined into DIR's series files,
+which the analysis reads (valve_scene.join_segments; the segments keep their logs, particle
+snapshots and restart points).
 """
 
 import argparse
@@ -159,6 +166,59 @@ def write_run_record(output_dir: Path, wall_s: float, exit_code: int, restart: P
         print(f"run_case: could not write {output_dir / 'wall_time.json'}: {error}", file=sys.stderr, flush=True)
 
 
+SEGMENTS_DIR = "segments"
+# What a join writes at the top of a resumed run's folder (valve_scene.join_segments), removed
+# before the next segment runs and written again after it.
+JOINED_FILES = ("solid_series.h5", "coupling_series.h5", "fluid_probes.h5", "solid_fields.h5", "segments.json",
+                "wall_time.json")
+
+
+def segment_folders(run_dir: Path) -> list[Path]:
+    folder = run_dir / SEGMENTS_DIR
+    if not folder.is_dir():
+        return []
+    return sorted((p for p in folder.iterdir() if p.is_dir() and p.name.isdigit()), key=lambda p: int(p.name))
+
+
+def prepare_resume(run_dir: Path) -> tuple[Path, Path | None]:
+    """The folder the resumed run writes to and the restart point it continues from: (RUN, None)
+    when RUN holds no run yet; else a new RUN/segments/NN and the newest segment's restart/."""
+    if not run_dir.exists() or not any(run_dir.iterdir()):
+        return run_dir, None
+    segments = segment_folders(run_dir)
+    if not segments:
+        first = run_dir / SEGMENTS_DIR / "01"
+        if not (run_dir / "restart" / "LATEST").is_file():
+            fail(f"--resume: '{run_dir}' holds no restart point (restart/LATEST; the case's "
+                 "coupling.restart_interval_s or solid.restart_interval_s writes them): nothing to continue from. "
+                 "Remove the folder, or run without --resume into another one, to start again")
+        first.mkdir(parents=True)
+        for entry in list(run_dir.iterdir()):
+            if entry.name != SEGMENTS_DIR:
+                entry.rename(first / entry.name)
+        segments = [first]
+    else:
+        for name in JOINED_FILES:  # the last join's output: written again from the segments
+            (run_dir / name).unlink(missing_ok=True)
+    restart = next((s / "restart" for s in reversed(segments) if (s / "restart" / "LATEST").is_file()), None)
+    if restart is None:
+        fail(f"--resume: no segment of '{run_dir}' holds a restart point (restart/LATEST): nothing to continue from")
+    return run_dir / SEGMENTS_DIR / f"{int(segments[-1].name) + 1:02d}", restart
+
+
+def join_resumed_run(run_dir: Path) -> None:
+    """Joins RUN's segments into RUN's series files; a failure leaves the segments as they are."""
+    sys.path.insert(0, str(REPO / "scripts"))
+    try:
+        from valve_scene.join_segments import JoinError, join
+        report = join(segment_folders(run_dir), run_dir)
+    except (ImportError, JoinError, OSError) as error:
+        print(f"run_case: could not join the segments of {run_dir} ({error}); each segment's output is kept in "
+              f"{run_dir / SEGMENTS_DIR}", file=sys.stderr, flush=True)
+        return
+    print("run_case: segments joined into " + str(run_dir) + ":\n  " + "\n  ".join(report.lines()), flush=True)
+
+
 def main():
     started_at = time.monotonic()
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -173,6 +233,9 @@ def main():
     parser.add_argument("--restart", type=Path,
                         help="continue from restart data: a run's restart/ folder or one restart/t_<time>/ folder "
                              "(the case's coupling.restart_interval_s writes them)")
+    parser.add_argument("--resume", action="store_true",
+                        help="continue the run in --output from its newest restart point as a new segment and join "
+                             "the segments (a new or empty folder: start the run)")
     parser.add_argument("--grace", type=float, default=5.0, help="seconds between SIGTERM and SIGKILL when stopping")
     args = parser.parse_args()
 
@@ -180,11 +243,18 @@ def main():
         fail(f"case file '{args.case}' does not exist")
     if args.fluid_ranks < 1:
         fail(f"--fluid-ranks = {args.fluid_ranks}: allowed >= 1")
+    if args.resume and args.restart:
+        fail("--resume finds its restart point itself: give --resume or --restart, not both")
     case_file = args.case.resolve()
     build_dir = args.build_dir.resolve()
     coupler = find_executable(args.coupler_exe or DEFAULT_PROGRAMS["coupler"], build_dir, "coupler")
     # Relative output folders (the case's or --output) are relative to where the launcher runs.
     output_dir = (args.output or Path(launch_plan(coupler, case_file)["output_dir"])).resolve()
+    run_dir = output_dir
+    if args.resume:
+        output_dir, args.restart = prepare_resume(run_dir)
+        if args.restart:
+            print(f"run_case: resuming {run_dir} from {args.restart} as segment {output_dir.name}", flush=True)
     plan = launch_plan(coupler, case_file, output_dir)
     output_dir.mkdir(parents=True, exist_ok=True)
     if not args.coupler_exe and plan["coupler"]["executable"]:
@@ -269,6 +339,8 @@ def main():
         print(f"run_case: finished in {wall_s:.1f} s wall time; logs and results in {output_dir}", flush=True)
     else:
         print(f"run_case: stopped after {wall_s:.1f} s wall time", file=sys.stderr, flush=True)
+    if output_dir != run_dir:
+        join_resumed_run(run_dir)
     sys.exit(exit_code)
 
 

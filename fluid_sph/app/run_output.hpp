@@ -77,6 +77,7 @@ class RunOutput {
         next_sample_ = t;
       if (series_.samples() % 200 == 0) flush();
     }
+    log_new_losses(solver);
     const auto now = Clock::now();
     if (std::chrono::duration<double>(now - last_report_).count() > 10.0) {
       last_report_ = now;
@@ -145,7 +146,26 @@ class RunOutput {
     last_sample_time_ = solver.time();
   }
 
+  // Each particle taken out for its density, once, as a warning (every rank logs its own).
+  void log_new_losses(const FluidSolver<D>& solver) {
+    const auto& losses = solver.named_losses();
+    for (; losses_logged_ < losses.size(); ++losses_logged_) {
+      const auto& l = losses[losses_logged_];
+      std::string where;
+      for (int d = 0; d < D; ++d) where += fmt::format("{}{:.6g}", d ? ", " : "", l.position[d]);
+      const double rest = solver.settings().rest_density;
+      spdlog::warn("particle {} taken out at t = {:.6g} s (step {}): density {:.5g} kg/m^3 ({:+.1f} % of rest, allowed "
+                   "+-{:g} %), at x = ({}) m, speed {:.3g} m/s{}",
+                   l.id, l.time, l.step, l.density, 100.0 * (l.density / rest - 1.0),
+                   100.0 * solver.settings().max_density_deviation, where, l.speed,
+                   l.near_surface ? ", within a support of the leaflets" : "");
+      if (losses_logged_ + 1 == FluidSolver<D>::kNamedLosses)
+        spdlog::warn("{} particles named as taken out: further ones are only counted", FluidSolver<D>::kNamedLosses);
+    }
+  }
+
   ProbeSet<D> probes_;
+  std::size_t losses_logged_ = 0;
   std::size_t plate_count_;
   bool interface_;
   bool root_;

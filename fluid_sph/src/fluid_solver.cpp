@@ -443,6 +443,7 @@ void FluidSolver<D>::step() {
   float max_speed2 = 0.0f, max_acc2 = 0.0f;
   const float density_limit = static_cast<float>(settings_.max_density_deviation * settings_.rest_density);
   std::size_t out_of_range = 0;
+  std::vector<std::size_t> taken_out;  // rare: each is logged below
 #pragma omp parallel for schedule(static) reduction(max : max_speed2, max_acc2) reduction(+ : out_of_range)
   for (std::ptrdiff_t i = first; i < last; ++i) {
     if (p.kind[i] != Kind::fluid) continue;
@@ -451,6 +452,8 @@ void FluidSolver<D>::step() {
     if (std::abs(p.density_excess[i]) > density_limit) {
       p.kind[i] = Kind::lost;
       ++out_of_range;
+#pragma omp critical(valvefsi_fluid_taken_out)
+      taken_out.push_back(static_cast<std::size_t>(i));
       continue;
     }
     float v2 = 0.0f, a2 = 0.0f;
@@ -472,6 +475,22 @@ void FluidSolver<D>::step() {
   max_acceleration_ = std::sqrt(max_acc2);
   lost_ += out_of_range;
   lost_density_ += out_of_range;
+  std::sort(taken_out.begin(), taken_out.end());  // the threads' order is not the particles'
+  for (const std::size_t i : taken_out) {
+    if (named_losses_.size() >= kNamedLosses) break;
+    TakenOut t;
+    t.id = p.id[i];
+    t.time = time_;
+    t.step = steps_ + 1;
+    for (int d = 0; d < D; ++d) {
+      t.position[d] = p.position[d][i];
+      t.speed += static_cast<double>(p.velocity[d][i]) * p.velocity[d][i];
+    }
+    t.speed = std::sqrt(t.speed);
+    t.density = settings_.rest_density + p.density_excess[i];
+    t.near_surface = i < near_surface_.size() && near_surface_[i];
+    named_losses_.push_back(t);
+  }
   if (settings_.shifting > 0) shift_particles(dt);
   ++steps_;
   if (surface_) check_leaks();  // the state is complete: it can be written

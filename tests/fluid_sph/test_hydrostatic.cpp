@@ -3,7 +3,9 @@
 // water's weight (action = reaction between fluid and dummy particles).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "valvefsi/fluid/fluid_solver.hpp"
 #include "valvefsi/fluid/geometry.hpp"
@@ -64,6 +66,35 @@ void check_column(KernelType kernel) {
   EXPECT_NEAR(solver.body_forces()[0][1], -mass * g, 0.02 * mass * g);
   EXPECT_NEAR(solver.body_forces()[0][0], 0.0, 0.01 * mass * g);
   EXPECT_EQ(solver.lost_count(), 0u);
+}
+
+// A density band narrower than the column's own hydrostatic compression (rho g H / c0^2 = 0.25 %
+// at the floor) takes out the deepest particles: each is named with where and how.
+TEST(Hydrostatic, ParticlesTakenOutForTheirDensityAreNamed) {
+  auto c = water_column(0.05, KernelType::cubic_spline);
+  c.settings.max_density_deviation = 0.001;
+  FluidSolver<2> solver(c.settings, fill_particles(c.scene, c.settings));
+  solver.advance_to(0.3);
+  const auto& named = solver.named_losses();
+  ASSERT_GT(solver.density_out_of_range_count(), 0u);
+  EXPECT_EQ(named.size(), std::min(solver.density_out_of_range_count(), FluidSolver<2>::kNamedLosses));
+  std::vector<std::uint32_t> ids;
+  for (const auto& l : named) {
+    EXPECT_GT(std::abs(l.density / 1000.0 - 1.0), 0.001);  // outside the band
+    EXPECT_LT(std::abs(l.density / 1000.0 - 1.0), 0.01);
+    EXPECT_GT(l.time, 0.0);
+    EXPECT_LE(l.time, 0.3 + 1e-12);
+    EXPECT_GT(l.step, 0);
+    EXPECT_GE(l.position[0], 0.0);                          // in the tank
+    EXPECT_LE(l.position[0], 1.0);
+    // deep enough for rho g d / c0^2 to leave the band: d > 0.4 m at rest, half that with the
+    // lattice start's overshoot (at most twice the static compression)
+    EXPECT_LT(l.position[1], 1.0 - 0.5 * 0.001 * c.settings.sound_speed * c.settings.sound_speed / 9.81);
+    EXPECT_FALSE(l.near_surface);
+    ids.push_back(l.id);
+  }
+  std::sort(ids.begin(), ids.end());
+  EXPECT_EQ(std::adjacent_find(ids.begin(), ids.end()), ids.end());  // each once
 }
 
 TEST(Hydrostatic, CubicSplineColumnHoldsProfile) { check_column(KernelType::cubic_spline); }

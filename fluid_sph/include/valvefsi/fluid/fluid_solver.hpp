@@ -110,6 +110,20 @@ class FluidSolver {
   // Particles taken out of the run: left the domain, or density out of range (of those).
   std::size_t lost_count() const { return lost_; }
   std::size_t density_out_of_range_count() const { return lost_density_; }
+  // The first kNamedLosses particles this process took out for their density, with where and
+  // how (the count above goes on; the programs log each as it appears): what an investigation
+  // of a loss needs without tracing the particle through snapshots.
+  struct TakenOut {
+    std::uint32_t id = 0;
+    double time = 0.0;      // s
+    long step = 0;
+    Vec<D> position{};      // m
+    double density = 0.0;   // kg/m^3
+    double speed = 0.0;     // m/s
+    bool near_surface = false;  // within a support of the immersed surface (leaflets)
+  };
+  static constexpr std::size_t kNamedLosses = 200;
+  const std::vector<TakenOut>& named_losses() const { return named_losses_; }
   const FluidSettings<D>& settings() const { return settings_; }
   const Particles<D>& particles() const { return particles_; }
   const CellGrid<D>& grid() const { return grid_; }
@@ -164,6 +178,7 @@ class FluidSolver {
   long steps_ = 0;
   std::size_t lost_ = 0;
   std::size_t lost_density_ = 0;
+  std::vector<TakenOut> named_losses_;
   bool plate_floor_reached_ = true;  // false from construction while a once-reached floor waits
   float max_speed_ = 0.0f;
   float max_acceleration_ = 0.0f;

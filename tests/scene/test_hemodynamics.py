@@ -181,12 +181,18 @@ class Cycles(unittest.TestCase):
         self.assertAlmostEqual(r.q_rms, math.sqrt(0.5 * QMAX ** 2 + 0.5 * (0.05 * QMAX) ** 2) * 1e6, delta=0.01 * QMAX * 1e6)
 
 
+def sixth_of_the_valve():
+    """The synthetic valve's series as a 1/6 sector measures it: flows and forces / 6."""
+    sector = synthetic()
+    sector.flow_rates = {k: v / 6 for k, v in sector.flow_rates.items()}
+    sector.axial_force = sector.axial_force / 6
+    return sector
+
+
 class Sector(unittest.TestCase):
     def test_a_sixth_of_the_valve_times_six_is_the_valve(self):
         full = synthetic()
-        sector = synthetic()
-        sector.flow_rates = {k: v / 6 for k, v in sector.flow_rates.items()}
-        sector.axial_force = sector.axial_force / 6
+        sector = sixth_of_the_valve()
         a = hd.analyse_cycle(full, smoothing_s=0.0)
         b = hd.analyse_cycle(sector, smoothing_s=0.0, symmetry_factor=6)
         for name in ("q_rms", "eoa", "regurgitant_volume", "pull_out_force", "diastolic_force", "water_hammer_ratio", "mspd_mmHg"):
@@ -268,11 +274,8 @@ class Files(unittest.TestCase):
             self.assertAlmostEqual(a.diastolic_force, b.diastolic_force, delta=1e-12)
 
     def test_the_fluids_recorded_symmetry_factor_scales_a_sector(self):
-        full = synthetic()
-        sector = synthetic()
-        sector.flow_rates = {k: v / 6 for k, v in sector.flow_rates.items()}
-        sector.axial_force = sector.axial_force / 6
-        expected = hd.analyse_cycle(full, smoothing_s=0.0)
+        expected = hd.analyse_cycle(synthetic(), smoothing_s=0.0)
+        sector = sixth_of_the_valve()
         with tempfile.TemporaryDirectory() as tmp:
             folder = Path(tmp)
             self.write_run(folder, sector)

@@ -146,7 +146,8 @@ class RunOutput {
     last_sample_time_ = solver.time();
   }
 
-  // Each particle taken out for its density, once, as a warning (every rank logs its own).
+  // Each particle taken out for its density, once, as a warning (every rank logs its own; a
+  // window the coupling repeats takes its losses back and names them again, logged once).
   void log_new_losses(const FluidSolver<D>& solver) {
     const auto& losses = solver.named_losses();
     for (; losses_logged_ < losses.size(); ++losses_logged_) {

@@ -45,7 +45,7 @@ struct FluidSolver<D>::Checkpoint {
   std::vector<Vec<D>> body_forces, body_acceleration;
   double time = 0.0, dt = 0.0;
   long steps = 0;
-  std::size_t lost = 0, lost_density = 0;
+  std::size_t lost = 0, lost_density = 0, named_losses = 0;
   bool plate_floor_reached = true;
   float max_speed = 0.0f, max_acceleration = 0.0f;
   std::size_t owned_begin = 0, owned_end = 0;
@@ -299,6 +299,7 @@ void FluidSolver<D>::save_checkpoint() {
   c.steps = steps_;
   c.lost = lost_;
   c.lost_density = lost_density_;
+  c.named_losses = named_losses_.size();
   c.plate_floor_reached = plate_floor_reached_;
   c.max_speed = max_speed_;
   c.max_acceleration = max_acceleration_;
@@ -322,6 +323,7 @@ void FluidSolver<D>::restore_checkpoint() {
   steps_ = c.steps;
   lost_ = c.lost;
   lost_density_ = c.lost_density;
+  named_losses_.resize(c.named_losses);  // a repeated window names its losses again
   plate_floor_reached_ = c.plate_floor_reached;
   max_speed_ = c.max_speed;
   max_acceleration_ = c.max_acceleration;

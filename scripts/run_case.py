@@ -200,10 +200,14 @@ def prepare_resume(run_dir: Path) -> tuple[Path, Path | None]:
     else:
         for name in JOINED_FILES:  # the last join's output: written again from the segments
             (run_dir / name).unlink(missing_ok=True)
-    restart = next((s / "restart" for s in reversed(segments) if (s / "restart" / "LATEST").is_file()), None)
-    if restart is None:
+    with_restart = [s for s in segments if (s / "restart" / "LATEST").is_file()]
+    if not with_restart:
         fail(f"--resume: no segment of '{run_dir}' holds a restart point (restart/LATEST): nothing to continue from")
-    return run_dir / SEGMENTS_DIR / f"{int(segments[-1].name) + 1:02d}", restart
+    # Segments stopped before their first restart point are redone by the new one from the same
+    # point: kept, renamed out of the join (it needs segments that start one after the other).
+    for dead_end in segments[segments.index(with_restart[-1]) + 1:]:
+        dead_end.rename(dead_end.with_name(dead_end.name + "-superseded"))
+    return run_dir / SEGMENTS_DIR / f"{int(segments[-1].name) + 1:02d}", with_restart[-1] / "restart"
 
 
 def join_resumed_run(run_dir: Path) -> None:

@@ -1,5 +1,6 @@
 """scripts/run_case.py finds the programs of the build tree it is given, not those of another
-build tree nested inside it (a helper's build/clean/ once won silently)."""
+build tree nested inside it (a helper's build/clean/ once won silently); --resume picks the
+newest restart point and sets aside segments stopped before their first one."""
 import os
 import tempfile
 import unittest
@@ -39,6 +40,30 @@ class ExecutableLookup(unittest.TestCase):
                 self.assertEqual(run_case.find_executable("solid_fe", build, "solid"), f"{tmp}/bin/solid_fe")
             finally:
                 os.environ["PATH"] = old
+
+
+
+class Resume(unittest.TestCase):
+    def test_a_segment_stopped_before_its_first_restart_point_is_set_aside(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            run = Path(tmp) / "run"
+            for name, has_restart in (("01", True), ("02", True), ("03", False)):
+                (run / "segments" / name).mkdir(parents=True)
+                if has_restart:
+                    (run / "segments" / name / "restart").mkdir()
+                    (run / "segments" / name / "restart" / "LATEST").write_text("t_0.1\n")
+            (run / "fluid_probes.h5").write_text("the last join")
+            segment, restart = run_case.prepare_resume(run)
+            self.assertEqual(segment, run / "segments" / "04")
+            self.assertEqual(restart, run / "segments" / "02" / "restart")
+            self.assertTrue((run / "segments" / "03-superseded").is_dir())
+            self.assertEqual([p.name for p in run_case.segment_folders(run)], ["01", "02"])
+            self.assertFalse((run / "fluid_probes.h5").exists())     # the join is written again
+
+    def test_an_empty_folder_starts_the_run_there(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            self.assertEqual(run_case.prepare_resume(Path(tmp)), (Path(tmp), None))
+            self.assertEqual(run_case.prepare_resume(Path(tmp) / "new"), (Path(tmp) / "new", None))
 
 
 if __name__ == "__main__":

@@ -704,9 +704,10 @@ def analyse_cycle(series: ProbeSeries, cycle: int = 2, period: float = waveform.
     the valve's closure within the cycle (e.g. from the kinematics) and splits closing from
     leakage volume. symmetry_factor multiplies the flows and forces of a symmetric part (6 for
     the 1/6 sector) into the whole valve's: by default the one the fluid recorded (1 for a run
-    written before it did); a given one that contradicts the record is refused. allow_partial accepts a series that ends before the
-    cycle does, once the forward flow has ended in it (a run that covers only the parts of the
-    cycle the metrics need): the result's series_end_s says where the diastolic quantities stop,
+    written before it did); a given one that contradicts the record is refused. allow_partial
+    accepts a series that ends before the cycle does, once the forward flow has ended in it (a
+    run that covers only the parts of the cycle the metrics need): the result's series_end_s
+    says where the diastolic quantities stop,
     and its regurgitant volume is closing + the leak rate x (cycle end - closure) when the leak
     rate is measured (regurgitant_extrapolated; leakage_volume stays the integral to the end).
     Where the series has particle snapshots (read_run) the leak through the valve by particle

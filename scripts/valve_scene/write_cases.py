@@ -193,7 +193,7 @@ FSI_3D_SOLID_STEPS_PER_WINDOW = 2
 # The solid's energy check keeps its default 0.2: session 15 raised it to 1.0 against the old
 # trapezoidal ledger's drift in the open valve (0.20 of the largest energy at 142 ms); with the
 # ledger of session 19 both sector cycles run from t = 0 through systole, closing and into
-# diastole (to 510 / 436 ms) with the check at 0.000 (docs/fsi-3d.md, session 22).
+# diastole (MHGO to 604 ms, Ogden to 522 ms) with the check at 0.000 (docs/fsi-3d.md, session 22).
 
 
 def fsi_implicit_solid_lines(particle_spacing: float) -> str:
